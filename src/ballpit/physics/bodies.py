@@ -1,0 +1,258 @@
+"""Sphere and Plane: live views onto one row of the world's arrays.
+
+A view holds only the world and an index, so it never goes stale when the arrays grow. Reading a
+vector gives a view of the row; assigning validates the value and writes it into the world.
+``SphereList``/``PlaneList`` are the sequences behind ``world.spheres``/``world.planes``; they also
+hand out whole columns (``world.spheres.positions``) for code that works on every ball at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from typing import TYPE_CHECKING, overload
+
+import numpy as np
+
+from . import collision, validation
+from .state import Q, V, W, X, Columns
+
+if TYPE_CHECKING:
+    from .world import World
+
+
+def _state_vector(cols: slice, name: str, length: int):
+    def get(self: Sphere) -> np.ndarray:
+        return self._world._spheres.state[self.index, cols]
+
+    def set(self: Sphere, value: object) -> None:
+        if name == "orientation":
+            vec = validation.quaternion(name, value)
+        else:
+            vec = validation.vector(name, value, length)
+        self._world._spheres.state[self.index, cols] = vec
+
+    return property(get, set, doc=f"The ball's {name.replace('_', ' ')} (world frame).")
+
+
+def _material(name: str, owner: str):
+    def get(self) -> float:
+        return float(getattr(self._columns, name)[self.index])
+
+    def set(self, value: object) -> None:
+        getattr(self._columns, name)[self.index] = validation.number(name, value, nonnegative=True)
+
+    return property(get, set, doc=f"The {owner}'s {name.replace('_', ' ')} coefficient.")
+
+
+class Sphere:
+    """A ball: a live view of row ``index`` of the world's sphere arrays."""
+
+    __slots__ = ("_world", "index")
+
+    def __init__(self, world: World, index: int) -> None:
+        self._world = world
+        self.index = index
+
+    @property
+    def _columns(self) -> Columns:
+        return self._world._spheres
+
+    position = _state_vector(X, "position", 3)
+    velocity = _state_vector(V, "velocity", 3)
+    orientation = _state_vector(Q, "orientation", 4)
+    angular_velocity = _state_vector(W, "angular_velocity", 3)
+    restitution = _material("restitution", "ball")
+    friction = _material("friction", "ball")
+    rolling_friction = _material("rolling_friction", "ball")
+
+    @property
+    def radius(self) -> float:
+        return float(self._columns.radius[self.index])
+
+    @property
+    def mass(self) -> float:
+        return float(self._columns.mass[self.index])
+
+    @property
+    def hollow(self) -> bool:
+        return bool(self._columns.hollow[self.index])
+
+    @property
+    def inertia(self) -> float:
+        """Moment of inertia about any axis through the centre: 2/5·m·r² solid, 2/3·m·r² hollow."""
+        return 1.0 / float(self._columns.inv_inertia[self.index])
+
+    def __repr__(self) -> str:
+        x, y, z = self.position
+        return f"Sphere(index={self.index}, position=({x:.4g}, {y:.4g}, {z:.4g}), radius={self.radius:g})"
+
+
+class Plane:
+    """A plane or finite rectangle: a live view of row ``index`` of the world's plane arrays."""
+
+    __slots__ = ("_world", "index")
+
+    def __init__(self, world: World, index: int) -> None:
+        self._world = world
+        self.index = index
+
+    @property
+    def _columns(self) -> Columns:
+        return self._world._planes
+
+    restitution = _material("restitution", "plane")
+    friction = _material("friction", "plane")
+    rolling_friction = _material("rolling_friction", "plane")
+
+    @property
+    def position(self) -> np.ndarray:
+        return self._columns.center[self.index]
+
+    @property
+    def normal(self) -> np.ndarray:
+        return self._columns.normal[self.index]
+
+    @property
+    def orientation(self) -> np.ndarray:
+        """The rotation taking the +y plane to this one, (x, y, z, w)."""
+        return self._columns.orientation[self.index]
+
+    @property
+    def axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """The in-plane width (+x turned) and depth (+z turned) directions."""
+        return self._columns.axis_u[self.index], self._columns.axis_v[self.index]
+
+    @property
+    def size(self) -> tuple[float, float] | None:
+        """(width, depth) in metres, or None for an infinite plane."""
+        half = self._columns.half_size[self.index]
+        if np.isinf(half).all():
+            return None
+        return float(2 * half[0]), float(2 * half[1])
+
+    @property
+    def infinite(self) -> bool:
+        return bool(np.isinf(self._columns.half_size[self.index]).all())
+
+    def _frame(self) -> tuple[np.ndarray, ...]:
+        c = self._columns
+        i = slice(self.index, self.index + 1)
+        return c.center[i], c.normal[i], c.axis_u[i], c.axis_v[i], c.half_size[i]
+
+    def signed_distance(self, points: object) -> np.ndarray | float:
+        """Signed distance of points from the plane's infinite extension, positive on the normal's side."""
+        p = np.asarray(points, float)
+        d = (p - self.position) @ self.normal
+        return float(d) if p.ndim == 1 else d
+
+    def closest_point(self, points: object) -> np.ndarray:
+        """The closest point on the (possibly finite) rectangle to each point."""
+        p = np.asarray(points, float)
+        flat = p.reshape(-1, 3)
+        center, normal, u, v, half = self._frame()
+        zeros = np.zeros(len(flat), dtype=np.intp)
+        closest = collision.closest_point_on_planes(flat, zeros, center, u, v, half)
+        return closest.reshape(p.shape)
+
+    def distance(self, points: object) -> np.ndarray | float:
+        """Unsigned distance from each point to the rectangle (face, edge or corner)."""
+        p = np.asarray(points, float)
+        d = np.linalg.norm(p - self.closest_point(p), axis=-1)
+        return float(d) if p.ndim == 1 else d
+
+    def __repr__(self) -> str:
+        n = self.normal
+        return f"Plane(index={self.index}, normal=({n[0]:.3g}, {n[1]:.3g}, {n[2]:.3g}), size={self.size})"
+
+
+class _Views(Sequence):
+    _view: type
+
+    def __init__(self, world: World) -> None:
+        self._world = world
+
+    def _count(self) -> int:
+        raise NotImplementedError
+
+    def __len__(self) -> int:
+        return self._count()
+
+    @overload
+    def __getitem__(self, i: int) -> Sphere | Plane: ...
+    @overload
+    def __getitem__(self, i: slice) -> list: ...
+    def __getitem__(self, i):
+        n = self._count()
+        if isinstance(i, slice):
+            return [self._view(self._world, k) for k in range(n)[i]]
+        k = int(i)
+        if k < 0:
+            k += n
+        if not 0 <= k < n:
+            raise IndexError(f"index {i} out of range for {n} bodies")
+        return self._view(self._world, k)
+
+    def __iter__(self) -> Iterator:
+        return (self._view(self._world, k) for k in range(self._count()))
+
+
+class SphereList(_Views):
+    """``world.spheres``: every ball as a view, plus whole columns for vectorised use."""
+
+    _view = Sphere
+
+    def _count(self) -> int:
+        return self._world._spheres.count
+
+    @property
+    def positions(self) -> np.ndarray:
+        return self._world._spheres.state[:, X]
+
+    @property
+    def velocities(self) -> np.ndarray:
+        return self._world._spheres.state[:, V]
+
+    @property
+    def orientations(self) -> np.ndarray:
+        return self._world._spheres.state[:, Q]
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        return self._world._spheres.state[:, W]
+
+    @property
+    def radii(self) -> np.ndarray:
+        return self._world._spheres.radius
+
+    @property
+    def masses(self) -> np.ndarray:
+        return self._world._spheres.mass
+
+
+class PlaneList(_Views):
+    """``world.planes``: every plane as a view, plus whole columns for vectorised use."""
+
+    _view = Plane
+
+    def _count(self) -> int:
+        return self._world._planes.count
+
+    @property
+    def centers(self) -> np.ndarray:
+        return self._world._planes.center
+
+    @property
+    def normals(self) -> np.ndarray:
+        return self._world._planes.normal
+
+    @property
+    def orientations(self) -> np.ndarray:
+        return self._world._planes.orientation
+
+    @property
+    def half_sizes(self) -> np.ndarray:
+        return self._world._planes.half_size
+
+    @property
+    def restitutions(self) -> np.ndarray:
+        return self._world._planes.restitution

@@ -1,0 +1,61 @@
+"""Named force terms. Each adds its linear and angular acceleration for a trial state.
+
+The integrators call every term at every stage, so velocity-dependent forces such as drag are
+evaluated where a multi-stage method needs them, not frozen at the start of the step.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from .state import V, W
+
+
+class ForceTerm(Protocol):
+    """Something that accelerates balls: adds into ``lin`` (N, 3) and ``ang`` (N, 3)."""
+
+    def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None: ...
+
+
+class Gravity:
+    """Uniform gravitational acceleration g."""
+
+    def __init__(self, g: np.ndarray) -> None:
+        self.g = g
+
+    def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
+        lin += self.g
+
+
+class LinearDrag:
+    """Linear drag: a = −c·v (c in 1/s)."""
+
+    def __init__(self, c: float) -> None:
+        self.c = c
+
+    def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
+        lin -= self.c * state[:, V]
+
+
+class AngularDrag:
+    """Angular drag: α = −c_ω·ω (c_ω in 1/s)."""
+
+    def __init__(self, c: float) -> None:
+        self.c = c
+
+    def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
+        ang -= self.c * state[:, W]
+
+
+class ConstantPerBall:
+    """Per-ball accelerations held constant over an interval: the contact solver's forces."""
+
+    def __init__(self, lin: np.ndarray, ang: np.ndarray) -> None:
+        self.lin = lin
+        self.ang = ang
+
+    def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
+        lin += self.lin
+        ang += self.ang
