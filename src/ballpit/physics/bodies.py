@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 
 from . import collision, validation
-from .state import Q, V, W, X, Columns
+from .state import Columns, Q, V, W, X
 
 if TYPE_CHECKING:
     from .world import World
@@ -149,7 +149,7 @@ class Plane:
         """The closest point on the (possibly finite) rectangle to each point."""
         p = np.asarray(points, float)
         flat = p.reshape(-1, 3)
-        center, normal, u, v, half = self._frame()
+        center, _normal, u, v, half = self._frame()
         zeros = np.zeros(len(flat), dtype=np.intp)
         closest = collision.closest_point_on_planes(flat, zeros, center, u, v, half)
         return closest.reshape(p.shape)

@@ -55,4 +55,6 @@ class Contacts:
             return Contacts.empty()
         if len(parts) == 1:
             return parts[0]
-        return Contacts(**{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Contacts)})
+        return Contacts(
+            **{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Contacts)}
+        )

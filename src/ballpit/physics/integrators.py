@@ -99,7 +99,9 @@ INTEGRATORS: dict[str, Integrator] = {
 }
 
 
-def integrate(method: Integrator, state: np.ndarray, forces: Sequence[ForceTerm], h: float, ws: Workspace) -> None:
+def integrate(
+    method: Integrator, state: np.ndarray, forces: Sequence[ForceTerm], h: float, ws: Workspace
+) -> None:
     """Advance ``state`` (N, 13) in place by ``h`` seconds and renormalise the orientations."""
     if state.shape[0] == 0 or h <= 0.0:
         return

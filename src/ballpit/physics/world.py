@@ -51,7 +51,7 @@ class World:
 
     @property
     def integrator(self) -> str:
-        """"euler", "rk2" or "rk4"; may be changed between steps."""
+        """ "euler", "rk2" or "rk4"; may be changed between steps."""
         return self._integrator.name
 
     @integrator.setter
@@ -209,7 +209,9 @@ class World:
         """
         center = validation.vector("position", position)
         if normal is not None and rotation is not None:
-            raise ValueError(f"give a plane's normal or its rotation, not both (normal={normal!r}, rotation={rotation!r})")
+            raise ValueError(
+                f"give a plane's normal or its rotation, not both (normal={normal!r}, rotation={rotation!r})"
+            )
         if rotation is not None:
             q = quaternion.from_euler_xyz(validation.vector("rotation", rotation))
         elif normal is not None:
@@ -262,4 +264,4 @@ class World:
         if not np.isfinite(state).all():
             bad = int(np.flatnonzero(~np.isfinite(state).all(axis=1))[0])
             state[:] = before
-            raise FloatingPointError(f"step produced a non-finite state for sphere #{bad}; the step was undone")
+            raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")

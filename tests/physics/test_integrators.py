@@ -1,0 +1,115 @@
+"""Integrators against closed-form free flight, drag and spin."""
+
+import math
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.physics import quaternion
+
+G = 9.81
+
+
+def run(world: ballpit.World, dt: float, duration: float) -> None:
+    for _ in range(round(duration / dt)):
+        world.step(dt)
+
+
+@pytest.mark.parametrize("integrator", ["rk2", "rk4"])
+def test_rk_methods_reproduce_free_fall_exactly(integrator):
+    world = ballpit.World(integrator=integrator)
+    ball = world.add_sphere(position=(1.0, 30.0, -2.0), velocity=(2.0, 3.0, 0.5))
+    run(world, 1 / 60, 2.0)
+    t = 2.0
+    expected = np.array([1.0 + 2.0 * t, 30.0 + 3.0 * t - 0.5 * G * t * t, -2.0 + 0.5 * t])
+    assert np.max(np.abs(ball.position - expected)) < 1e-8
+    assert np.max(np.abs(ball.velocity - [2.0, 3.0 - G * t, 0.5])) < 1e-8
+
+
+def test_euler_free_fall_error_is_half_g_t_dt_and_halves_with_dt():
+    errors = []
+    for dt in (1 / 60, 1 / 120):
+        world = ballpit.World(integrator="euler")
+        ball = world.add_sphere(position=(0.0, 50.0, 0.0))
+        run(world, dt, 2.0)
+        exact = 50.0 - 0.5 * G * 2.0**2
+        error = ball.position[1] - exact
+        # Forward Euler lags by one step of velocity: y_n = y0 − ½g·t² + ½g·t·dt.
+        assert error == pytest.approx(0.5 * G * 2.0 * dt, rel=1e-9)
+        errors.append(error)
+    assert errors[0] / errors[1] == pytest.approx(2.0, rel=1e-6)
+
+
+def drag_position(t: float, x0, v0, g, c):
+    """Closed form of x'' = g − c·x': x = x0 + (g/c)t + (v0 − g/c)(1 − e^(−ct))/c."""
+    x0, v0, g = (np.asarray(a, float) for a in (x0, v0, g))
+    return x0 + g / c * t + (v0 - g / c) * (1 - math.exp(-c * t)) / c
+
+
+@pytest.mark.parametrize(("integrator", "order"), [("euler", 1), ("rk2", 2), ("rk4", 4)])
+def test_linear_drag_error_shrinks_at_the_integrators_order(integrator, order):
+    c, duration = 0.8, 2.0
+    x0, v0, g = (0.0, 10.0, 0.0), (3.0, 12.0, -1.0), (0.0, -G, 0.0)
+    exact = drag_position(duration, x0, v0, g, c)
+    errors = []
+    for dt in (0.1, 0.05, 0.025):
+        world = ballpit.World(gravity=g, integrator=integrator, linear_drag=c)
+        ball = world.add_sphere(position=x0, velocity=v0)
+        run(world, dt, duration)
+        errors.append(np.linalg.norm(ball.position - exact))
+    observed = [math.log2(errors[i] / errors[i + 1]) for i in range(2)]
+    assert observed == pytest.approx([order, order], abs=0.15)
+
+
+def test_angular_drag_decays_spin_exponentially():
+    c = 1.5
+    world = ballpit.World(gravity=(0, 0, 0), angular_drag=c)
+    ball = world.add_sphere(angular_velocity=(0.0, 4.0, 3.0))
+    run(world, 1 / 240, 1.0)
+    assert ball.angular_velocity == pytest.approx(np.array([0.0, 4.0, 3.0]) * math.exp(-c), rel=1e-8)
+
+
+@pytest.mark.parametrize("integrator", ["euler", "rk2", "rk4"])
+def test_quarter_turn_about_y_takes_x_to_minus_z(integrator):
+    world = ballpit.World(gravity=(0, 0, 0), integrator=integrator)
+    ball = world.add_sphere(angular_velocity=(0.0, 2 * math.pi, 0.0))
+    run(world, 1 / 240, 0.25)
+    x_axis = quaternion.rotate(ball.orientation, np.array([1.0, 0.0, 0.0]))
+    tolerance = {"euler": 1e-3, "rk2": 1e-4, "rk4": 1e-8}[integrator]
+    assert x_axis == pytest.approx([0.0, 0.0, -1.0], abs=tolerance)
+
+
+@pytest.mark.parametrize("integrator", ["euler", "rk2", "rk4"])
+def test_quaternion_stays_unit_and_on_course_over_ten_seconds_of_fast_spin(integrator):
+    omega = np.array([30.0, -20.0, 45.0])
+    world = ballpit.World(gravity=(0, 0, 0), integrator=integrator)
+    ball = world.add_sphere(angular_velocity=omega)
+    norms = []
+    for _ in range(2400):
+        world.step(1 / 240)
+        norms.append(np.linalg.norm(ball.orientation))
+    assert np.max(np.abs(np.array(norms) - 1.0)) < 1e-12
+
+
+def test_rk4_orientation_follows_the_exact_rotation_over_ten_seconds_of_fast_spin():
+    omega = np.array([30.0, -20.0, 45.0])  # 58 rad/s: 0.24 rad per step at 240 Hz
+    world = ballpit.World(gravity=(0, 0, 0), integrator="rk4")
+    ball = world.add_sphere(angular_velocity=omega)
+    run(world, 1 / 240, 10.0)
+    # Constant ω: the exact orientation is a rotation by |ω|·t about ω̂ (583 rad in all).
+    speed = np.linalg.norm(omega)
+    exact = quaternion.from_axis_angle(omega / speed, speed * 10.0)
+    assert min(np.linalg.norm(ball.orientation - exact), np.linalg.norm(ball.orientation + exact)) < 1e-3
+
+
+def test_integrator_can_be_switched_on_a_live_world():
+    world = ballpit.World(integrator="euler")
+    ball = world.add_sphere(position=(0, 10, 0))
+    world.step(0.1)
+    assert ball.position[1] == pytest.approx(10.0)  # Euler moves with the old velocity (zero)
+    world.integrator = "rk4"
+    world.step(0.1)
+    # RK4 is exact from the state it was handed: y = 10 + v·t − ½g·t², v = −0.981.
+    assert ball.position[1] == pytest.approx(10.0 - 0.0981 - 0.5 * G * 0.01, abs=1e-12)
+    assert world.integrator == "rk4"

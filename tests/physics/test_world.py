@@ -1,0 +1,168 @@
+"""World construction, views, planes and argument checking."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import ballpit
+
+
+def test_views_read_and_write_the_world_arrays():
+    world = ballpit.World()
+    ball = world.add_sphere(position=(1, 2, 3), radius=0.25, mass=2.0)
+    ball.velocity = (4.0, 0.0, 0.0)
+    assert world.spheres.velocities[0] == pytest.approx([4.0, 0.0, 0.0])
+    world.spheres.positions[0] = (7.0, 8.0, 9.0)
+    assert ball.position == pytest.approx([7.0, 8.0, 9.0])
+    assert (ball.radius, ball.mass, ball.index) == (0.25, 2.0, 0)
+    assert ball.orientation == pytest.approx([0, 0, 0, 1])
+
+
+@pytest.mark.parametrize(("hollow", "factor"), [(False, 2 / 5), (True, 2 / 3)])
+def test_sphere_inertia_is_the_textbook_value(hollow, factor):
+    world = ballpit.World()
+    ball = world.add_sphere(radius=0.3, mass=2.0, hollow=hollow)
+    assert ball.inertia == pytest.approx(factor * 2.0 * 0.3**2)
+
+
+def test_adding_ten_thousand_balls_one_by_one_grows_storage_geometrically():
+    world = ballpit.World()
+    capacities = set()
+    for i in range(10_000):
+        world.add_sphere(position=(i, 0, 0), radius=0.1)
+        capacities.add(world._spheres.capacity)
+    assert len(world.spheres) == 10_000
+    assert len(capacities) <= math.ceil(math.log2(10_000 / 16)) + 1  # doubling: a copy per power of two
+    assert world.spheres[-1].position == pytest.approx([9999, 0, 0])
+
+
+def test_batch_add_broadcasts_arguments():
+    world = ballpit.World()
+    idx = world.add_spheres(np.zeros((5, 3)) + [[0, 1, 0]], radius=[0.1, 0.2, 0.3, 0.4, 0.5], mass=2.0)
+    assert list(idx) == [0, 1, 2, 3, 4]
+    assert world.spheres.radii == pytest.approx([0.1, 0.2, 0.3, 0.4, 0.5])
+    assert world.spheres[3].inertia == pytest.approx(0.4 * 2.0 * 0.16)
+
+
+@pytest.mark.parametrize("angles", [(0, 0, 30), (25, -40, 70), (180, 0, 0), (10, 200, -35)])
+def test_plane_rotation_is_extrinsic_xyz_degrees(angles):
+    world = ballpit.World()
+    plane = world.add_plane(rotation=angles, size=2.0)
+    expected = Rotation.from_euler("xyz", angles, degrees=True)
+    assert plane.normal == pytest.approx(expected.apply([0, 1, 0]), abs=1e-12)
+    assert plane.axes[0] == pytest.approx(expected.apply([1, 0, 0]), abs=1e-12)
+    q = plane.orientation
+    assert min(np.abs(q - expected.as_quat()).max(), np.abs(q + expected.as_quat()).max()) < 1e-12
+
+
+def test_plane_from_normal_takes_the_shortest_turn_and_flips_about_x_for_down():
+    world = ballpit.World()
+    tilted = world.add_plane(normal=(1, 1, 0), size=(2.0, 3.0))
+    assert tilted.normal == pytest.approx(np.array([1, 1, 0]) / math.sqrt(2))
+    assert tilted.axes[0] == pytest.approx(np.array([1, -1, 0]) / math.sqrt(2))  # +x turned 45° about −z
+    assert tilted.axes[1] == pytest.approx([0, 0, 1])
+    assert tilted.size == (2.0, 3.0)
+    down = world.add_plane(normal=(0, -1, 0))
+    assert down.normal == pytest.approx([0, -1, 0])
+    assert down.axes[0] == pytest.approx([1, 0, 0])
+    assert down.axes[1] == pytest.approx([0, 0, -1])
+    assert down.size is None and down.infinite
+    assert world.add_plane().normal == pytest.approx([0, 1, 0])
+
+
+def test_plane_queries_cover_face_edge_and_corner():
+    world = ballpit.World()
+    square = world.add_plane(position=(0, 1, 0), size=2.0)
+    assert square.signed_distance([0.5, 3.0, 0.5]) == pytest.approx(2.0)
+    assert square.signed_distance([0.5, -1.0, 0.5]) == pytest.approx(-2.0)
+    assert square.closest_point([0.5, 3.0, -0.5]) == pytest.approx([0.5, 1.0, -0.5])  # face
+    assert square.closest_point([3.0, 2.0, 0.2]) == pytest.approx([1.0, 1.0, 0.2])  # edge
+    assert square.closest_point([3.0, 2.0, -4.0]) == pytest.approx([1.0, 1.0, -1.0])  # corner
+    assert square.distance([4.0, 5.0, 1.0]) == pytest.approx(5.0)  # from the corner (1, 1, 1)
+    many = square.closest_point(np.array([[0, 5, 0], [9, 1, 9]]))
+    assert many == pytest.approx(np.array([[0, 1, 0], [1, 1, 1]]))
+
+
+BAD_SPHERES = [
+    ({"radius": -1.0}, "radius", ValueError),
+    ({"radius": 0.0}, "radius", ValueError),
+    ({"mass": 0.0}, "mass", ValueError),
+    ({"mass": float("inf")}, "mass", ValueError),
+    ({"position": (0, float("nan"), 0)}, "position", ValueError),
+    ({"position": (0, 1)}, "position", ValueError),
+    ({"velocity": (1, 2, 3, 4)}, "velocity", ValueError),
+    ({"velocity": "fast"}, "velocity", TypeError),
+    ({"angular_velocity": (0, float("inf"), 0)}, "angular_velocity", ValueError),
+    ({"orientation": (0, 0, 0, 0)}, "orientation", ValueError),
+    ({"restitution": -0.5}, "restitution", ValueError),
+    ({"friction": "lots"}, "friction", TypeError),
+    ({"hollow": "yes"}, "hollow", TypeError),
+]
+
+
+@pytest.mark.parametrize(("kwargs", "name", "error"), BAD_SPHERES)
+def test_add_sphere_rejects_bad_input_naming_argument_and_value(kwargs, name, error):
+    world = ballpit.World()
+    with pytest.raises(error) as info:
+        world.add_sphere(**kwargs)
+    message = str(info.value)
+    assert name in message
+    assert repr(next(iter(kwargs.values()))) in message
+    assert len(world.spheres) == 0
+
+
+BAD_PLANES = [
+    ({"normal": (0, 0, 0)}, "normal"),
+    ({"normal": (0, 1, 0), "rotation": (0, 0, 10)}, "normal"),
+    ({"rotation": (0, 0)}, "rotation"),
+    ({"size": -2.0}, "size"),
+    ({"size": (1.0, 0.0)}, "size"),
+    ({"size": (1.0, 2.0, 3.0)}, "size"),
+    ({"position": (0, float("nan"), 0)}, "position"),
+]
+
+
+@pytest.mark.parametrize(("kwargs", "name"), BAD_PLANES)
+def test_add_plane_rejects_bad_input_naming_argument(kwargs, name):
+    world = ballpit.World()
+    with pytest.raises((ValueError, TypeError), match=name):
+        world.add_plane(**kwargs)
+    assert len(world.planes) == 0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"integrator": "rk5"}, "integrator"),
+        ({"gravity": (0, -9.81)}, "gravity"),
+        ({"linear_drag": -1.0}, "linear_drag"),
+        ({"angular_drag": float("nan")}, "angular_drag"),
+        ({"restitution_threshold": -0.1}, "restitution_threshold"),
+    ],
+)
+def test_world_rejects_bad_parameters(kwargs, name):
+    with pytest.raises((ValueError, TypeError), match=name):
+        ballpit.World(**kwargs)
+
+
+def test_setting_a_non_finite_value_is_rejected_and_the_world_keeps_no_nan():
+    world = ballpit.World()
+    ball = world.add_sphere(position=(0, 1, 0))
+    with pytest.raises(ValueError, match="velocity"):
+        ball.velocity = (float("nan"), 0, 0)
+    with pytest.raises(ValueError, match="dt"):
+        world.step(float("nan"))
+    with pytest.raises(ValueError, match="dt"):
+        world.step(-0.1)
+    with pytest.raises(ValueError, match="integrator"):
+        world.integrator = "verlet"
+    assert np.isfinite(world._spheres.state).all()
+
+
+def test_step_advances_time():
+    world = ballpit.World()
+    world.step(0.25)
+    world.step(0.25)
+    assert world.time == pytest.approx(0.5)
