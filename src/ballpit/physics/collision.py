@@ -27,3 +27,47 @@ def closest_point_on_planes(
     du = np.clip(np.einsum("ij,ij->i", d, u), -half_size[plane, 0], half_size[plane, 0])
     dv = np.clip(np.einsum("ij,ij->i", d, v), -half_size[plane, 1], half_size[plane, 1])
     return c + du[:, None] * u + dv[:, None] * v
+
+
+def sphere_plane(
+    x: np.ndarray,
+    radius: np.ndarray,
+    sphere: np.ndarray,
+    plane: np.ndarray,
+    side: np.ndarray,
+    planes,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gap, unit normal (towards the ball) and contact point for each (sphere, plane) pair.
+
+    ``side`` (±1) is the side of the plane each ball started the step on. A ball whose centre has
+    crossed the face (which continuous detection prevents, but an edited scene can cause) is pushed back
+    to the side it came from instead of through.
+    """
+    p = x[sphere]
+    point = closest_point_on_planes(p, plane, planes.center, planes.axis_u, planes.axis_v, planes.half_size)
+    delta = p - point
+    dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
+    plane_normal = planes.normal[plane]
+    signed = np.einsum("ij,ij->i", delta, plane_normal)
+    in_plane = dist - np.abs(signed)  # zero when the closest point is on the face, not an edge or corner
+    on_face = in_plane <= 1e-12 * np.maximum(dist, 1.0)
+    crossed = on_face & (signed * side <= 0.0)
+    safe = np.where(dist > 1e-12, dist, 1.0)
+    normal = np.where(on_face[:, None], side[:, None] * plane_normal, delta / safe[:, None])
+    gap = np.where(crossed, -np.abs(signed), dist) - radius[sphere]
+    return gap, normal, point
+
+
+def sphere_sphere(
+    x: np.ndarray, radius: np.ndarray, i: np.ndarray, j: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gap, unit normal (from j towards i) and contact point (middle of the gap) for each pair."""
+    delta = x[i] - x[j]
+    dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
+    # Coincident centres have no normal; pick +y so the pair separates vertically.
+    normal = np.where(
+        (dist > 1e-12)[:, None], delta / np.where(dist > 1e-12, dist, 1.0)[:, None], [0.0, 1.0, 0.0]
+    )
+    gap = dist - radius[i] - radius[j]
+    point = x[j] + normal * (radius[j] + 0.5 * gap)[:, None]
+    return gap, normal, point

@@ -4,16 +4,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import quaternion, validation
+from . import broadphase, collision, quaternion, solver, toi, validation
 from .bodies import Plane, PlaneList, Sphere, SphereList
-from .contacts import Contacts
-from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
+from .contacts import SPHERE_PLANE, SPHERE_SPHERE, Candidates, Contacts, ContactSet, EventLog
+from .forces import AngularDrag, ConstantPerBall, ForceTerm, Gravity, LinearDrag
 from .integrators import INTEGRATORS, Integrator, Workspace, integrate
+from .solver import ContactBatch, Impulses
 from .state import Q, V, W, X, plane_columns, sphere_columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
 SOLID_INERTIA = 2.0 / 5.0
 HOLLOW_INERTIA = 2.0 / 3.0
+
+# Balls closer than this (m) are in contact: the solver holds them, time of impact stops here.
+CONTACT_SLOP = 1e-5
+# Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
+APPROACH_SPEED = 1e-6
+# A step is split at most this many times; past it the rest of the step is taken whole.
+MAX_INTERVALS = 10_000
+# Explicit Euler's default restitution threshold, in units of |g|·dt (see _bounce_threshold).
+EULER_THRESHOLD_STEPS = 8.0
 
 
 class World:
@@ -36,9 +46,13 @@ class World:
         self.angular_drag = angular_drag
         self.restitution_threshold = restitution_threshold
         self.time = 0.0
+        self.solver_iterations = 10
         self._spheres = sphere_columns()
         self._planes = plane_columns()
         self._workspace = Workspace()
+        # Resting contact forces from the last interval, by pair key, to warm-start the solver.
+        self._warm_keys = np.zeros(0, np.int64)
+        self._warm_forces = Impulses.zeros(0)
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -248,15 +262,299 @@ class World:
         return terms
 
     def step(self, dt: float) -> Contacts:
-        """Advance the world by ``dt`` seconds; returns the contacts resolved in the step."""
+        """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
+
+        The step is split at every impact. Each interval runs the same stages: find the contacts,
+        push overlapping balls apart, bounce the ones that arrive, solve the resting contacts for
+        constant forces over the interval, predict the next impact, and integrate to it.
+        """
         dt = validation.number("dt", dt, positive=True)
         state = self._spheres.state
         before = state.copy()
-        integrate(self._integrator, state, self.forces(), dt, self._workspace)
-        contacts = Contacts.empty()
+        forces = self.forces()
+        threshold = self._bounce_threshold(dt)
+        events = EventLog()
+        candidates = self._broad_phase(dt, self._free_acceleration(forces)[0])
+        elapsed, intervals = 0.0, 0
+        while elapsed < dt:
+            remaining = dt - elapsed
+            contacts = self._narrow_phase(candidates)
+            touching = contacts.subset(contacts.gap < CONTACT_SLOP)
+            batch = self._contact_batch(touching)
+            self._remove_penetration(touching, batch)
+            now = self.time + elapsed
+            self._bounce(touching, batch, threshold, events, now)
+            push = self._resting_forces(touching, batch, forces, remaining, events, now)
+            lin = self._free_acceleration(forces)[0] + push.lin
+            if self._escapes_boxes(candidates, lin, remaining):
+                candidates = self._broad_phase(remaining, lin)
+                contacts = self._narrow_phase(candidates)
+            intervals += 1
+            if intervals < MAX_INTERVALS:
+                h = min(self._next_impact(contacts, lin, remaining), remaining)
+            else:  # a pathological pile-up: finish the step without splitting it further
+                h = remaining
+            integrate(self._integrator, state, [*forces, push], h, self._workspace)
+            events.close_interval(h / remaining)
+            elapsed = dt if h >= remaining else elapsed + h
         self._reject_non_finite(before)
         self.time += dt
-        return contacts
+        return events.record()
+
+    # ------------------------------------------------------------------ step stages
+    def _free_acceleration(self, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
+        """Linear and angular acceleration from the force terms alone, at the current state."""
+        state = self._spheres.state
+        lin = np.zeros((len(state), 3))
+        ang = np.zeros((len(state), 3))
+        for term in forces:
+            term.add(state, lin, ang)
+        return lin, ang
+
+    def _path_end(self, accel: np.ndarray, h: float) -> np.ndarray:
+        """Where each ball would be after ``h`` along the path the integrator takes."""
+        state = self._spheres.state
+        end = state[:, X] + state[:, V] * h
+        if self._integrator.quadratic_path:
+            end += 0.5 * h * h * accel
+        return end
+
+    def _broad_phase(self, h: float, accel: np.ndarray) -> Candidates:
+        """Candidate pairs for the next ``h`` seconds, from boxes around each ball's swept path."""
+        state, radius = self._spheres.state, self._spheres.radius
+        x = state[:, X]
+        margin = np.linalg.norm(accel, axis=1) * h * h + 0.02 * radius + CONTACT_SLOP
+        lo, hi = broadphase.swept_boxes(x, self._path_end(accel, h), radius, margin)
+        i, j = broadphase.sphere_pairs(lo, hi)
+        pl = self._planes
+        s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
+        signed = np.einsum("ij,ij->i", x[s] - pl.center[p], pl.normal[p])
+        return Candidates(lo, hi, i, j, s, p, np.where(signed < 0.0, -1.0, 1.0))
+
+    def _escapes_boxes(self, candidates: Candidates, accel: np.ndarray, h: float) -> bool:
+        """True when some ball's path for the next ``h`` leaves the box it was paired from."""
+        x, radius = self._spheres.state[:, X], self._spheres.radius
+        end = self._path_end(accel, h)
+        # a parabola strays at most ⅛·|a|·h² from the chord between its ends
+        sag = 0.125 * h * h * np.linalg.norm(accel, axis=1) if self._integrator.quadratic_path else 0.0
+        pad = (radius + sag)[:, None]
+        return bool(
+            np.any(np.minimum(x, end) - pad < candidates.lo)
+            or np.any(np.maximum(x, end) + pad > candidates.hi)
+        )
+
+    def _narrow_phase(self, candidates: Candidates) -> ContactSet:
+        """Gap, normal and point of every candidate pair at the current positions."""
+        x, radius = self._spheres.state[:, X], self._spheres.radius
+        c = candidates
+        gp, np_, pp = collision.sphere_plane(x, radius, c.sphere, c.plane, c.side, self._planes)
+        gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
+        static = np.full(len(c.sphere), self._spheres.count)
+        return ContactSet(
+            kind=np.concatenate((np.full(len(gp), SPHERE_PLANE), np.full(len(gs), SPHERE_SPHERE))),
+            a=np.concatenate((c.sphere, c.pair_i)),
+            b=np.concatenate((static, c.pair_j)),
+            other=np.concatenate((c.plane, c.pair_j)),
+            gap=np.concatenate((gp, gs)),
+            normal=np.concatenate((np_, ns)),
+            point=np.concatenate((pp, ps)),
+        )
+
+    def _contact_batch(self, c: ContactSet) -> ContactBatch:
+        """Masses, lever arms and mixed materials of the touching contacts, grouped into colours."""
+        sph, pl = self._spheres, self._planes
+        with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
+        radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
+        on_plane = c.kind == SPHERE_PLANE
+        p = np.where(on_plane, c.other, 0)
+        o = np.where(on_plane, 0, c.other)
+
+        def mixed(ball: np.ndarray, plane: np.ndarray, rule) -> np.ndarray:
+            other = np.where(on_plane, plane[p] if len(plane) else 0.0, ball[o])
+            return rule(ball[c.a], other)
+
+        ra, rb = radius[c.a], radius[c.b]
+        # Rolling resistance acts through the rolling radius: r for a ball on a plane, the reduced
+        # radius 2·r_a·r_b/(r_a + r_b) between two balls.
+        roll_radius = np.where(on_plane, ra, 2.0 * ra * rb / np.where(on_plane, 1.0, ra + rb))
+        return ContactBatch(
+            a=c.a,
+            b=c.b,
+            normal=c.normal,
+            arm_a=-ra[:, None] * c.normal,
+            arm_b=rb[:, None] * c.normal,
+            inv_mass_a=inv_mass[c.a],
+            inv_mass_b=inv_mass[c.b],
+            inv_inertia_a=inv_inertia[c.a],
+            inv_inertia_b=inv_inertia[c.b],
+            restitution=mixed(sph.restitution, pl.restitution, np.multiply),
+            friction=np.sqrt(mixed(sph.friction, pl.friction, np.multiply)),
+            rolling=np.sqrt(mixed(sph.rolling_friction, pl.rolling_friction, np.multiply)) * roll_radius,
+            colours=solver.colour(c.a, c.b, sph.count),
+        )
+
+    def _velocities(self) -> tuple[np.ndarray, np.ndarray]:
+        """Copies of v and ω with the static row N (always zero) appended."""
+        state = self._spheres.state
+        return np.vstack((state[:, V], np.zeros(3))), np.vstack((state[:, W], np.zeros(3)))
+
+    def _remove_penetration(self, c: ContactSet, batch: ContactBatch) -> None:
+        """Move overlapping balls apart along the contact normals, positions only (no velocity is added).
+
+        A few Gauss–Seidel sweeps over the linearised gaps g = n·(x_a − x_b) − offset, each ball moved in
+        proportion to its inverse mass.
+        """
+        if not np.any(c.gap < 0.0):
+            return
+        x = self._spheres.state[:, X]
+        pos = np.vstack((x, np.zeros(3)))
+        n = c.normal
+        offset = np.einsum("ij,ij->i", n, pos[c.a] - pos[c.b]) - c.gap
+        share = batch.inv_mass_a / (batch.inv_mass_a + batch.inv_mass_b)
+        for _ in range(4):
+            for idx in batch.colours:
+                a, b = c.a[idx], c.b[idx]
+                gap = np.einsum("ij,ij->i", n[idx], pos[a] - pos[b]) - offset[idx]
+                depth = np.maximum(-gap, 0.0)[:, None] * n[idx]
+                pos[a] += depth * share[idx, None]
+                pos[b] -= depth * (1.0 - share[idx, None])
+            pos[-1] = 0.0
+        x[:] = pos[:-1]
+
+    def _bounce(
+        self, c: ContactSet, batch: ContactBatch, threshold: float, events: EventLog, now: float
+    ) -> None:
+        """Impacts: contacts arriving faster than the threshold leave at e times their approach speed.
+
+        All touching contacts take part, so a ball landing on a stack pushes through it; contacts
+        arriving slower than the threshold just stop.
+        """
+        if len(c) == 0:
+            return
+        v, w = self._velocities()
+        ra, rb = batch.arm_a, batch.arm_b
+        rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
+        vn = np.einsum("ij,ij->i", rel, c.normal)
+        if not np.any(vn < -APPROACH_SPEED):
+            return
+        target = np.where(-vn > threshold, -batch.restitution * vn, 0.0)
+        target = np.maximum(target, 0.0)
+        imp = solver.solve(batch, v, w, target, Impulses.zeros(len(c)), self.solver_iterations)
+        state = self._spheres.state
+        state[:, V] = v[:-1]
+        state[:, W] = w[:-1]
+        events.add(now, c, c.keys(self._spheres.count), imp.normal)
+
+    def _resting_forces(
+        self,
+        c: ContactSet,
+        batch: ContactBatch,
+        forces: list[ForceTerm],
+        h: float,
+        events: EventLog,
+        now: float,
+    ) -> ConstantPerBall:
+        """Constant contact forces over the next ``h`` seconds that leave every touching contact
+        not approaching, not slipping beyond the friction cone, at the end of the interval.
+
+        Solving for end-of-interval velocities and applying the impulses as constant forces keeps the
+        integrators exact: a resting ball's force cancels gravity, so it reports zero velocity.
+        """
+        n = self._spheres.count
+        if len(c) == 0:
+            return ConstantPerBall(0.0, 0.0)
+        lin, ang = self._free_acceleration(forces)
+        v, w = self._velocities()
+        v[:-1] += lin * h
+        w[:-1] += ang * h
+        v_free, w_free = v.copy(), w.copy()
+        keys = c.keys(n)
+        imp = self._warm_impulses(keys, c.normal, h)
+        solver.warm_start(batch, v, w, imp)
+        solver.solve(batch, v, w, np.zeros(len(c)), imp, self.solver_iterations)
+        order = np.argsort(keys)
+        self._warm_keys = keys[order]
+        self._warm_forces = Impulses(imp.normal[order] / h, imp.friction[order] / h, imp.rolling[order] / h)
+        events.add_resting(now, c, keys, imp.normal)
+        return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)
+
+    def _warm_impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
+        """Last interval's contact forces for the pairs still touching, as impulses over ``h``."""
+        imp = Impulses.zeros(len(keys))
+        if len(self._warm_keys) == 0:
+            return imp
+        pos = np.searchsorted(self._warm_keys, keys)
+        pos = np.minimum(pos, len(self._warm_keys) - 1)
+        found = self._warm_keys[pos] == keys
+        src = pos[found]
+        imp.normal[found] = self._warm_forces.normal[src] * h
+        friction = self._warm_forces.friction[src] * h
+        n = normal[found]
+        imp.friction[found] = (
+            friction - np.einsum("ij,ij->i", friction, n)[:, None] * n
+        )  # onto today's tangent plane
+        imp.rolling[found] = self._warm_forces.rolling[src] * h
+        return imp
+
+    def _next_impact(self, c: ContactSet, accel: np.ndarray, h: float) -> float:
+        """Time until the first pair not yet touching comes into contact (inf if none within h)."""
+        apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+        if apart.size == 0:
+            return np.inf
+        state = self._spheres.state
+        x, v = np.vstack((state[:, X], np.zeros(3))), np.vstack((state[:, V], np.zeros(3)))
+        acc = np.vstack((accel, np.zeros(3))) if self._integrator.quadratic_path else np.zeros((len(x), 3))
+        a, b = c.a[apart], c.b[apart]
+        bound = np.linalg.norm(v[a] - v[b], axis=1) + np.linalg.norm(acc[a] - acc[b], axis=1) * h
+        reachable = c.gap[apart] <= bound * h
+        apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
+        if apart.size == 0:
+            return np.inf
+        on_plane = c.kind[apart] == SPHERE_PLANE
+        radius = np.append(self._spheres.radius, 0.0)
+        reach = radius[a] + radius[b]
+        pl = self._planes
+
+        def gap_at(k: np.ndarray, t: np.ndarray) -> np.ndarray:
+            tt = t[:, None]
+            pa = x[a[k]] + v[a[k]] * tt + 0.5 * acc[a[k]] * tt * tt
+            pb = x[b[k]] + v[b[k]] * tt + 0.5 * acc[b[k]] * tt * tt
+            plane_k = on_plane[k]
+            if plane_k.any():
+                pk = c.other[apart[k[plane_k]]]
+                pb[plane_k] = collision.closest_point_on_planes(
+                    pa[plane_k], pk, pl.center, pl.axis_u, pl.axis_v, pl.half_size
+                )
+            return np.linalg.norm(pa - pb, axis=1) - reach[k]
+
+        return float(toi.first_contact(gap_at, bound, h, 0.5 * CONTACT_SLOP).min())
+
+    def _bounce_threshold(self, dt: float) -> float:
+        """The approach speed below which contacts do not bounce.
+
+        Default 2·|g|·dt: a ball bouncing slower than that would land again within a step or two.
+        Explicit Euler gains g·dt of speed every flight, so a ball with restitution e settles into
+        endless bounces at an arrival speed of g·dt/(1 − e) unless the threshold is above it; its
+        default of 8·|g|·dt brings every bounce with e ≤ 0.85 to rest.
+        """
+        if self._restitution_threshold is not None:
+            return self._restitution_threshold
+        factor = EULER_THRESHOLD_STEPS if self._integrator.name == "euler" else 2.0
+        return factor * float(np.linalg.norm(self._gravity)) * dt
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy of all balls (J)."""
+        sph = self._spheres
+        v, w = sph.state[:, V], sph.state[:, W]
+        return float(
+            0.5 * (sph.mass @ np.einsum("ij,ij->i", v, v))
+            + 0.5 * ((1.0 / sph.inv_inertia) @ np.einsum("ij,ij->i", w, w))
+        )
+
+    def potential_energy(self) -> float:
+        """Gravitational potential energy −Σ m·g·x (J), zero at the origin."""
+        sph = self._spheres
+        return float(-(sph.mass @ (sph.state[:, X] @ self._gravity)))
 
     def _reject_non_finite(self, before: np.ndarray) -> None:
         """Keep the world free of NaN/inf: restore the state and raise if a step produced any."""

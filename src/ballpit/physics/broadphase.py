@@ -1,0 +1,123 @@
+"""Broad phase: which pairs could touch during the step, from each ball's swept bounding box.
+
+Sphere pairs come from a uniform grid built by sorting cell keys (no Python loop over balls, cost
+linear in N plus the sort). The cell is as large as a typical box, so two overlapping boxes sit in the
+same or neighbouring cells; the rare box much larger than the cell (a very fast ball) is tested against
+every box directly. Sphere–plane pairs test each box against each rectangle's extent.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
+_OFFSETS = np.array(
+    [(0, 0, 0)]
+    + [
+        (dx, dy, dz)
+        for dx in (-1, 0, 1)
+        for dy in (-1, 0, 1)
+        for dz in (-1, 0, 1)
+        if (dx, dy, dz) > (0, 0, 0)
+    ],
+    dtype=np.int64,
+)
+
+
+def swept_boxes(
+    start: np.ndarray, end: np.ndarray, radius: np.ndarray, margin: np.ndarray | float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes around each ball's path from ``start`` to ``end``, grown by its radius and a margin."""
+    pad = (radius + margin)[:, None]
+    return np.minimum(start, end) - pad, np.maximum(start, end) + pad
+
+
+def _ranges(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each k, the integers starts[k] … starts[k]+counts[k]−1, flattened, with their owner k."""
+    total = int(counts.sum())
+    owner = np.repeat(np.arange(len(counts)), counts)
+    first = np.cumsum(counts) - counts
+    return owner, np.arange(total) - first[owner] + starts[owner]
+
+
+def _overlap(lo: np.ndarray, hi: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    return np.all((lo[i] <= hi[j]) & (lo[j] <= hi[i]), axis=1)
+
+
+def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All pairs (i < j) of boxes that overlap."""
+    n = len(lo)
+    if n < 2:
+        empty = np.zeros(0, np.intp)
+        return empty, empty
+    extent = (hi - lo).max(axis=1)
+    cell = 2.0 * float(np.median(extent))
+    big = extent > cell
+    small = np.flatnonzero(~big)
+    pairs_i, pairs_j = [], []
+
+    if len(small) > 1:
+        center = 0.5 * (lo[small] + hi[small])
+        c = np.floor(center / cell).astype(np.int64)
+        c -= c.min(axis=0) - 1  # keep neighbour cells non-negative
+        dims = c.max(axis=0) + 2
+        key = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+        order = np.argsort(key, kind="stable")
+        sorted_key = key[order]
+        for off in _OFFSETS:
+            neighbour = key + (off[0] * dims[1] + off[1]) * dims[2] + off[2]
+            start = np.searchsorted(sorted_key, neighbour, "left")
+            count = np.searchsorted(sorted_key, neighbour, "right") - start
+            owner, pos = _ranges(start, count)
+            i, j = owner, order[pos]
+            if not off.any():
+                keep = i < j  # same cell: each unordered pair once, and never a ball with itself
+                i, j = i[keep], j[keep]
+            i, j = small[i], small[j]
+            hit = _overlap(lo, hi, i, j)
+            pairs_i.append(i[hit])
+            pairs_j.append(j[hit])
+
+    for b in np.flatnonzero(big):
+        others = np.flatnonzero(np.all((lo <= hi[b]) & (lo[b] <= hi), axis=1))
+        others = others[(others != b) & (~big[others] | (others > b))]
+        pairs_i.append(np.full(len(others), b))
+        pairs_j.append(others)
+
+    if not pairs_i:
+        empty = np.zeros(0, np.intp)
+        return empty, empty
+    i = np.concatenate(pairs_i)
+    j = np.concatenate(pairs_j)
+    lo_ij, hi_ij = np.minimum(i, j), np.maximum(i, j)
+    order = np.lexsort((hi_ij, lo_ij))  # a fixed order keeps the whole step deterministic
+    return lo_ij[order], hi_ij[order]
+
+
+def sphere_plane_pairs(
+    lo: np.ndarray,
+    hi: np.ndarray,
+    center: np.ndarray,
+    normal: np.ndarray,
+    axis_u: np.ndarray,
+    axis_v: np.ndarray,
+    half_size: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs (sphere, plane) whose box reaches the plane's rectangle."""
+    box_center = 0.5 * (lo + hi)
+    box_radius = 0.5 * np.linalg.norm(hi - lo, axis=1)
+    spheres, planes = [], []
+    for p in range(len(center)):
+        d = box_center - center[p]
+        du = np.abs(d @ axis_u[p]) - half_size[p, 0]
+        dv = np.abs(d @ axis_v[p]) - half_size[p, 1]
+        dn = d @ normal[p]
+        # distance from the box centre to the rectangle, against the box's bounding-sphere radius
+        dist2 = np.maximum(du, 0.0) ** 2 + np.maximum(dv, 0.0) ** 2 + dn**2
+        hit = np.flatnonzero(dist2 <= box_radius**2)
+        spheres.append(hit)
+        planes.append(np.full(len(hit), p))
+    if not spheres:
+        empty = np.zeros(0, np.intp)
+        return empty, empty
+    return np.concatenate(spheres), np.concatenate(planes)
