@@ -1,0 +1,31 @@
+// Shared lighting and fog for balls and planes. Colours arrive in sRGB; lighting is done in linear
+// space and converted back, which keeps shading soft and highlights believable.
+
+uniform vec3 u_eye;          // camera position, world space
+uniform vec3 u_background;   // clear colour (sRGB); fog fades towards it
+uniform float u_fog_density; // 1/m; 0 disables fog
+
+const vec3 SUN_DIRECTION = normalize(vec3(0.35, 0.85, 0.40));
+const vec3 SUN_COLOR = vec3(1.00, 0.96, 0.88);
+const vec3 SKY_AMBIENT = vec3(0.34, 0.38, 0.46);
+const vec3 GROUND_AMBIENT = vec3(0.16, 0.15, 0.14);
+
+vec3 to_linear(vec3 c) { return pow(max(c, vec3(0.0)), vec3(2.2)); }
+vec3 to_srgb(vec3 c) { return pow(max(c, vec3(0.0)), vec3(1.0 / 2.2)); }
+
+// Hemisphere ambient + one directional sun (Lambert) + Blinn-Phong highlight.
+vec3 shade(vec3 albedo_srgb, vec3 n, vec3 position, float shininess, float specular) {
+    vec3 albedo = to_linear(albedo_srgb);
+    vec3 v = normalize(u_eye - position);
+    float diffuse = max(dot(n, SUN_DIRECTION), 0.0);
+    vec3 ambient = mix(GROUND_AMBIENT, SKY_AMBIENT, 0.5 + 0.5 * n.y);
+    vec3 h = normalize(SUN_DIRECTION + v);
+    float highlight = diffuse > 0.0 ? pow(max(dot(n, h), 0.0), shininess) * specular : 0.0;
+    return to_srgb(albedo * (ambient + SUN_COLOR * diffuse) + SUN_COLOR * highlight);
+}
+
+// Exponential-squared fog towards the background with distance from the eye.
+vec3 fog(vec3 color_srgb, vec3 position) {
+    float d = length(position - u_eye) * u_fog_density;
+    return mix(color_srgb, u_background, 1.0 - exp(-d * d));
+}

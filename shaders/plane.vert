@@ -1,0 +1,27 @@
+#version 330 core
+// Planes as quads. Each vertex carries its plane-local coordinates (metres from the centre along the
+// plane's width and depth axes) for the grid, the plane's half extents for the edge band, its normal
+// and its colour (bounciness).
+
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec2 a_local;
+layout(location = 2) in vec2 a_half_size;   // a very large value for an infinite plane
+layout(location = 3) in vec3 a_normal;
+layout(location = 4) in vec3 a_color;
+
+uniform mat4 u_view_projection;
+
+out vec3 v_world;
+out vec2 v_local;
+flat out vec2 v_half_size;
+flat out vec3 v_normal;
+flat out vec3 v_color;
+
+void main() {
+    v_world = a_position;
+    v_local = a_local;
+    v_half_size = a_half_size;
+    v_normal = a_normal;
+    v_color = a_color;
+    gl_Position = u_view_projection * vec4(a_position, 1.0);
+}

@@ -1,0 +1,315 @@
+"""The viewer window: pyglet event loop, input handling, camera flying, HUD, reload and screenshots.
+
+``run`` is what ``ballpit`` / ``ballpit view`` call. ``Viewer`` is the window itself; tests drive it
+frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from datetime import datetime
+from pathlib import Path
+
+from . import backend, controls
+from .controls import Action
+from .simulation import Simulation
+
+TITLE_INTERVAL = 0.5  # seconds between FPS title updates
+HUD_INTERVAL = 0.1  # seconds between HUD text updates
+WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
+FRAME_INTERVAL = 1.0 / 120.0  # redraw rate asked of pyglet's loop (vsync may cap it lower)
+
+
+def default_scene() -> Path:
+    """The bundled slopes demo."""
+    try:
+        from importlib import resources
+
+        path = resources.files("ballpit.scenes") / "slopes.toml"
+        if path.is_file():
+            return Path(str(path))
+    except ModuleNotFoundError:
+        pass
+    # an editable install cannot import the namespace package; use the checkout's scenes/
+    return Path(__file__).resolve().parents[3] / "scenes" / "slopes.toml"
+
+
+def _is_no_display(exc: BaseException) -> bool:
+    return type(exc).__name__ == "NoSuchDisplayException"
+
+
+def title(scene_name: str, fps: float) -> str:
+    """The window title; it always ends with the frame rate as ``<number> FPS``."""
+    return f"ballpit — {scene_name} — {fps:.1f} FPS"
+
+
+class Viewer:
+    """One window on one Simulation."""
+
+    def __init__(
+        self,
+        world: object | None = None,
+        scene_path: Path | None = None,
+        size: tuple[int, int] = (1280, 720),
+        visible: bool = True,
+    ) -> None:
+        backend.use_window()
+        import pyglet
+
+        from .camera import Camera
+        from .frame import FrameFeeder, OverlayFlags
+        from .hud import Hud
+        from .renderer import Renderer
+
+        if world is None:
+            import ballpit
+
+            scene_path = Path(scene_path) if scene_path is not None else default_scene()
+            world = ballpit.load_scene(scene_path)
+        self.sim = Simulation(world, scene_path)
+        look = self.sim.appearance
+        self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
+        self.window = self._open_window(size, visible)
+        self.renderer = Renderer()
+        self.feeder = FrameFeeder(self.renderer)
+        self.flags = OverlayFlags()
+        self.hud = Hud(self.window)
+        self.held: set[str] = set()
+        self.mouse_captured = False
+        self.closed = False
+        self.screenshot_requested = False
+        self.last_screenshot: Path | None = None
+        self.physics_seconds = 0.0
+        self.fps = 0.0
+        self.frames = 0
+        now = time.perf_counter()
+        self._last_frame = now
+        self._fps_since, self._fps_frames = now, 0
+        self._hud_at = 0.0
+        self._watch_at = now + WATCH_INTERVAL
+        self._shown_message = ""
+        self.window.set_caption(title(look.name, 0.0))
+        self.window.push_handlers(self)
+        self._pyglet = pyglet
+
+    # ------------------------------------------------------------------ window
+    def _open_window(self, size: tuple[int, int], visible: bool):
+        import pyglet
+        from pyglet import gl
+
+        base = dict(
+            major_version=3, minor_version=3, forward_compatible=True, double_buffer=True, depth_size=24
+        )
+        attempts = [dict(base, sample_buffers=1, samples=4), base]
+        for i, attrs in enumerate(attempts):
+            try:
+                window = pyglet.window.Window(
+                    width=size[0], height=size[1], caption="ballpit", resizable=True, vsync=True,
+                    visible=visible, config=gl.Config(**attrs),
+                )  # fmt: skip
+            except pyglet.window.NoSuchConfigException:
+                if i == len(attempts) - 1:
+                    raise
+                continue
+            self.multisample = bool(attrs.get("samples"))
+            return window
+        raise AssertionError("unreachable")
+
+    # ------------------------------------------------------------------ actions
+    def perform(self, action: Action) -> None:
+        """Do what a key asks for."""
+        sim = self.sim
+        if action is Action.START:
+            sim.start()
+        elif action is Action.PAUSE:
+            sim.toggle_pause()
+        elif action is Action.STEP:
+            sim.step_once()
+        elif action is Action.RESET:
+            sim.reset()
+        elif action is Action.RELOAD:
+            self.reload()
+        elif action in controls.INTEGRATOR_ACTIONS:
+            sim.set_integrator(controls.INTEGRATOR_ACTIONS[action])
+        elif action is Action.FASTER:
+            sim.faster()
+        elif action is Action.SLOWER:
+            sim.slower()
+        elif action is Action.CAPTURE_MOUSE:
+            self.capture_mouse(not self.mouse_captured)
+        elif action is Action.ESCAPE:
+            if controls.escape_outcome(self.mouse_captured) == "release":
+                self.capture_mouse(False)
+            else:
+                self.close()
+        elif action is Action.CONTACTS:
+            self.flags.contacts = not self.flags.contacts
+        elif action is Action.VELOCITIES:
+            self.flags.velocities = not self.flags.velocities
+        elif action is Action.TRAILS:
+            self.flags.trails = not self.flags.trails
+        elif action is Action.HUD:
+            self.hud.show_hud = not self.hud.show_hud
+        elif action is Action.HELP:
+            self.hud.show_help = not self.hud.show_help
+        elif action is Action.SCREENSHOT:
+            self.screenshot_requested = True
+        self._hud_at = 0.0  # refresh the HUD on the next frame
+
+    def reload(self) -> bool:
+        ok = self.sim.reload()
+        self.hud.set_error(self.sim.error)
+        return ok
+
+    def capture_mouse(self, captured: bool) -> None:
+        self.mouse_captured = captured
+        self.window.set_exclusive_mouse(captured)
+
+    def close(self) -> None:
+        if not self.closed:
+            self.closed = True
+            self.window.close()
+
+    # ------------------------------------------------------------------ pyglet events
+    def on_key_press(self, symbol: int, modifiers: int) -> bool:
+        from pyglet.window import key
+
+        name = key.symbol_string(symbol)
+        self.held.add(name)
+        action = controls.action_for_key(name, ctrl=bool(modifiers & key.MOD_ACCEL))
+        if action is not None:
+            self.perform(action)
+        return True  # handled: stops pyglet's default "Esc closes the window"
+
+    def on_key_release(self, symbol: int, modifiers: int) -> bool:
+        from pyglet.window import key
+
+        self.held.discard(key.symbol_string(symbol))
+        return True
+
+    def on_deactivate(self) -> None:
+        self.held.clear()
+
+    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        if buttons & mouse.RIGHT or self.mouse_captured:
+            self.camera.look(dx, dy)
+
+    def on_mouse_motion(self, x: int, y: int, dx: int, dy: int) -> None:
+        if self.mouse_captured:
+            self.camera.look(dx, dy)
+
+    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
+        self.camera.speed = controls.scrolled_fly_speed(self.camera.speed, scroll_y)
+
+    def on_resize(self, width: int, height: int) -> None:
+        self.hud.layout()  # pyglet's own handler (viewport, HUD projection) runs after this one
+
+    def on_close(self) -> None:
+        self.closed = True
+
+    def on_draw(self) -> None:
+        self.frame()
+
+    # ------------------------------------------------------------------ the frame
+    def frame(self, dt: float | None = None) -> None:
+        """Advance the camera and physics by real time (or by ``dt``) and draw one frame."""
+        now = time.perf_counter()
+        elapsed = now - self._last_frame if dt is None else dt
+        self._last_frame = now
+        self.camera.fly(
+            controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
+        )
+
+        started = time.perf_counter()
+        self.sim.advance(elapsed)
+        self.physics_seconds = time.perf_counter() - started
+        if now >= self._watch_at:
+            self._watch_at = now + WATCH_INTERVAL
+            if self.sim.file_changed():
+                self.reload()
+
+        self.window.switch_to()
+        self.feeder.upload(self.sim, self.flags)
+        width, height = self.window.get_framebuffer_size()
+        self.renderer.draw(self.camera, width, height, multisample=self.multisample)
+        self._draw_hud(now)
+        if self.screenshot_requested:
+            self.screenshot_requested = False
+            self.save_screenshot(width, height)
+        self._count_frame(now)
+
+    def _overlay_names(self) -> str:
+        f = self.flags
+        return " ".join(name for name, on in (("contacts", f.contacts), ("velocities", f.velocities),
+                                              ("trails", f.trails)) if on)  # fmt: skip
+
+    def _draw_hud(self, now: float) -> None:
+        from .hud import hud_lines
+
+        if now >= self._hud_at:
+            self._hud_at = now + HUD_INTERVAL
+            self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names()))
+            self.hud.set_error(self.sim.error)
+        if self.sim.message != self._shown_message:
+            self._shown_message = self.sim.message
+            if self.sim.message:
+                self.hud.flash(self.sim.message, now)
+        self.hud.draw(now)
+
+    def _count_frame(self, now: float) -> None:
+        self.frames += 1
+        self._fps_frames += 1
+        if now - self._fps_since >= TITLE_INTERVAL:
+            self.fps = self._fps_frames / (now - self._fps_since)
+            self._fps_since, self._fps_frames = now, 0
+            self.window.set_caption(title(self.sim.appearance.name, self.fps))
+
+    def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
+        """Save the back buffer (what this frame drew, HUD included) as a PNG; prints the path."""
+        import numpy as np
+        from OpenGL import GL
+        from PIL import Image
+
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        GL.glReadBuffer(GL.GL_BACK)
+        data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+        image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
+        directory = Path.cwd() if directory is None else directory
+        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+        path = directory / f"ballpit-{stamp}.png"
+        n = 1
+        while path.exists():
+            n += 1
+            path = directory / f"ballpit-{stamp}-{n}.png"
+        Image.fromarray(image).save(path)
+        self.last_screenshot = path.resolve()
+        print(f"screenshot saved to {self.last_screenshot}", flush=True)
+        self.hud.flash(f"screenshot saved to {self.last_screenshot}", time.perf_counter())
+        return self.last_screenshot
+
+    def run(self) -> None:
+        """pyglet's event loop until the window closes."""
+        self._pyglet.app.run(FRAME_INTERVAL)
+
+
+def run(scene_path: Path | None = None) -> int:
+    """Open the viewer on a scene file (the bundled slopes demo by default); returns the exit status.
+
+    With no display it prints one line saying how to render offscreen instead and returns 1.
+    """
+    problem = backend.display_problem()
+    if problem is not None:
+        print(backend.no_display_message(problem), file=sys.stderr)
+        return 1
+    try:
+        viewer = Viewer(scene_path=scene_path)
+    except Exception as exc:
+        if _is_no_display(exc):
+            print(backend.no_display_message(str(exc) or "cannot connect"), file=sys.stderr)
+            return 1
+        raise
+    viewer.run()
+    return 0

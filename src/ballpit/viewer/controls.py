@@ -1,0 +1,150 @@
+"""Input → action mapping for the viewer, kept free of pyglet and GL so it is unit-testable.
+
+Keys are named as in ``pyglet.window.key`` (``key.symbol_string(symbol)``: "X", "SPACE", "_1", "F5",
+"NUM_ADD", ...). The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of
+the F1 overlay and is built from the same bindings.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from enum import Enum
+
+import numpy as np
+
+
+class Action(Enum):
+    """Everything a key press can ask the viewer to do."""
+
+    START = "start the drop"
+    PAUSE = "pause / resume"
+    STEP = "single step while paused"
+    RESET = "reset to the initial state"
+    RELOAD = "reload the scene file"
+    EULER = "integrator: Euler"
+    RK2 = "integrator: RK2"
+    RK4 = "integrator: RK4"
+    FASTER = "faster time"
+    SLOWER = "slower time"
+    CAPTURE_MOUSE = "capture / release the mouse for looking"
+    ESCAPE = "release the mouse, or quit"
+    CONTACTS = "show contact points and normals"
+    VELOCITIES = "show velocity arrows"
+    TRAILS = "show trails"
+    HUD = "show / hide the HUD"
+    HELP = "show / hide this help"
+    SCREENSHOT = "save a screenshot PNG"
+
+
+KEY_ACTIONS: dict[str, Action] = {
+    "X": Action.START,
+    "SPACE": Action.PAUSE,
+    "N": Action.STEP,
+    "RIGHT": Action.STEP,
+    "R": Action.RESET,
+    "F5": Action.RELOAD,
+    "_1": Action.EULER,
+    "NUM_1": Action.EULER,
+    "_2": Action.RK2,
+    "NUM_2": Action.RK2,
+    "_3": Action.RK4,
+    "NUM_3": Action.RK4,
+    # "+" is Shift+"=" on most layouts and arrives as EQUAL.
+    "EQUAL": Action.FASTER,
+    "PLUS": Action.FASTER,
+    "NUM_ADD": Action.FASTER,
+    "MINUS": Action.SLOWER,
+    "UNDERSCORE": Action.SLOWER,
+    "NUM_SUBTRACT": Action.SLOWER,
+    "TAB": Action.CAPTURE_MOUSE,
+    "ESCAPE": Action.ESCAPE,
+    "C": Action.CONTACTS,
+    "V": Action.VELOCITIES,
+    "T": Action.TRAILS,
+    "H": Action.HUD,
+    "F1": Action.HELP,
+    "F12": Action.SCREENSHOT,
+}
+
+CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
+
+INTEGRATOR_ACTIONS: dict[Action, str] = {Action.EULER: "euler", Action.RK2: "rk2", Action.RK4: "rk4"}
+
+# Held keys that fly the camera, as (right, up, forward) components.
+FLY_KEYS: dict[str, tuple[float, float, float]] = {
+    "W": (0.0, 0.0, 1.0),
+    "S": (0.0, 0.0, -1.0),
+    "A": (-1.0, 0.0, 0.0),
+    "D": (1.0, 0.0, 0.0),
+    "Q": (0.0, -1.0, 0.0),
+    "E": (0.0, 1.0, 0.0),
+}
+SHIFT_KEYS = frozenset({"LSHIFT", "RSHIFT"})
+SHIFT_SPEEDUP = 4.0
+
+# Fly speed (m/s) changes by this factor per scroll notch, within these bounds.
+SCROLL_FACTOR = 1.25
+FLY_SPEED_RANGE = (0.05, 500.0)
+
+# Time scale (simulated seconds per real second) steps by a factor of 2 within these bounds.
+TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
+
+HELP: tuple[tuple[str, str], ...] = (
+    ("X", "start the drop (the scene waits until X)"),
+    ("Space", "pause / resume"),
+    ("N or →", "single step while paused"),
+    ("R", "reset to the initial state (then X drops again)"),
+    ("Ctrl+R or F5", "reload the scene file (also on save)"),
+    ("1 / 2 / 3", "integrator Euler / RK2 / RK4"),
+    ("+ / −", "faster / slower time"),
+    ("W A S D, Q E", "fly forward/left/back/right, down/up"),
+    ("Shift", "fly faster; scroll changes fly speed"),
+    ("right drag or Tab", "look around (Tab captures the mouse)"),
+    ("Esc", "release the mouse; again to quit"),
+    ("C / V / T", "contacts and normals / velocity arrows / trails"),
+    ("H / F1", "HUD / this help"),
+    ("F12", "screenshot PNG (path printed)"),
+)
+
+
+def action_for_key(name: str, ctrl: bool = False) -> Action | None:
+    """The action bound to a key press, or None. ``name`` is pyglet's key symbol name."""
+    if ctrl:
+        return CTRL_KEY_ACTIONS.get(name)
+    return KEY_ACTIONS.get(name)
+
+
+def fly_direction(held: Iterable[str]) -> np.ndarray:
+    """The camera-relative (right, up, forward) direction the held keys ask for, of length 0 or 1."""
+    move = np.zeros(3)
+    for name in held:
+        if name in FLY_KEYS:
+            move += FLY_KEYS[name]
+    length = np.linalg.norm(move)
+    return move / length if length > 0 else move
+
+
+def fly_speed_multiplier(held: Iterable[str]) -> float:
+    """Shift (either side) flies faster."""
+    return SHIFT_SPEEDUP if SHIFT_KEYS.intersection(held) else 1.0
+
+
+def scrolled_fly_speed(speed: float, notches: float) -> float:
+    """The fly speed after scrolling ``notches`` (positive: up, faster), kept within FLY_SPEED_RANGE."""
+    low, high = FLY_SPEED_RANGE
+    return float(np.clip(speed * SCROLL_FACTOR**notches, low, high))
+
+
+def faster(scale: float) -> float:
+    """The next time scale up (×2), capped."""
+    return min(scale * 2.0, TIME_SCALE_RANGE[1])
+
+
+def slower(scale: float) -> float:
+    """The next time scale down (÷2), capped."""
+    return max(scale / 2.0, TIME_SCALE_RANGE[0])
+
+
+def escape_outcome(mouse_captured: bool) -> str:
+    """Esc releases a captured mouse first ("release"); otherwise it quits ("quit")."""
+    return "release" if mouse_captured else "quit"

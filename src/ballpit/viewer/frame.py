@@ -1,0 +1,60 @@
+"""Feeding a frame to the renderer from a Simulation: planes when the scene changes, the interpolated
+balls and the enabled overlays every frame. Shared by the window and the offscreen renderer."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import overlays
+from .renderer import Renderer
+from .simulation import Simulation
+
+
+@dataclass
+class OverlayFlags:
+    """Which debug overlays are shown (C, V, T)."""
+
+    contacts: bool = False
+    velocities: bool = False
+    trails: bool = False
+
+
+class FrameFeeder:
+    """Uploads what the renderer needs for one frame and times it."""
+
+    def __init__(self, renderer: Renderer) -> None:
+        self.renderer = renderer
+        self._generation: int | None = None
+        self._sim: Simulation | None = None
+        self.upload_seconds = 0.0
+
+    def upload(self, sim: Simulation, flags: OverlayFlags | None = None) -> None:
+        started = time.perf_counter()
+        flags = flags or OverlayFlags()
+        look = sim.appearance
+        world = sim.world
+        if sim is not self._sim or sim.generation != self._generation:
+            planes = world.planes
+            self.renderer.set_planes(
+                planes.centers, planes.orientations, planes.half_sizes, look.plane_colors
+            )
+            self._sim, self._generation = sim, sim.generation
+        positions, orientations = sim.render_state()
+        spheres = world.spheres
+        self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors)
+
+        world_lines, overlay_lines = overlays.empty(), overlays.empty()
+        if flags.trails and sim.trails.filled:
+            world_lines = overlays.trail_lines(sim.trails.ordered(), look.sphere_colors, positions)
+        parts = []
+        if flags.contacts and sim.contacts is not None and len(sim.contacts):
+            parts.append(overlays.contact_lines(sim.contacts.point, sim.contacts.normal))
+        if flags.velocities:
+            parts.append(overlays.velocity_arrows(positions, np.asarray(spheres.velocities)))
+        if parts:
+            overlay_lines = np.concatenate(parts)
+        self.renderer.upload_lines(world_lines, overlay_lines)
+        self.upload_seconds = time.perf_counter() - started

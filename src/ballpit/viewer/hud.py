@@ -1,0 +1,131 @@
+"""The HUD (H), the key help (F1), transient messages and the scene error, drawn with pyglet text.
+
+``hud_lines`` builds the HUD text from a Simulation without GL so it can be tested; ``Hud`` lays the
+labels out in the window's top-left corner (help centred, errors along the bottom).
+"""
+
+from __future__ import annotations
+
+import pyglet
+
+from .controls import HELP
+from .simulation import Phase, Simulation
+
+FONT = ("DejaVu Sans Mono", "Menlo", "Consolas", "Courier New", "monospace")
+FONT_SIZE = 11
+TEXT_COLOR = (235, 238, 245, 255)
+ERROR_COLOR = (255, 110, 100, 255)
+PANEL_COLOR = (10, 12, 18, 170)
+MARGIN = 10
+MESSAGE_SECONDS = 3.0
+
+
+def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
+    """The HUD's text: time, speed, integrator, step rate, counts, energy and the run state."""
+    world = sim.world
+    state = sim.phase.value
+    if sim.phase is Phase.RUNNING and sim.time_scale != 1.0:
+        state = f"running at ×{sim.time_scale:g}"
+    return [
+        f"{sim.appearance.name}",
+        f"sim time    {world.time:9.3f} s",
+        f"time scale  ×{sim.time_scale:g}   real-time factor {sim.real_time_factor:.2f}",
+        f"integrator  {world.integrator.upper():5s} dt {sim.timestep * 1000:.2f} ms",
+        f"steps/s     {sim.steps_per_second:9.0f}",
+        f"balls       {sim.ball_count:9d}",
+        f"contacts    {sim.last_step_contacts:9d}",
+        f"kinetic E   {sim.kinetic_energy():9.3f} J",
+        f"fly speed   {fly_speed:9.2f} m/s",
+        f"overlays    {overlays or 'none'} (C V T)",
+        f"state       {state}",
+        "F1 help  H hide",
+    ]
+
+
+def help_text() -> str:
+    width = max(len(keys) for keys, _ in HELP)
+    rows = [f"{keys:<{width}}  {what}" for keys, what in HELP]
+    return "\n".join(["ballpit controls", "", *rows, "", "plane colour: blue dead → green → orange bouncy"])
+
+
+class Hud:
+    """pyglet labels for the HUD panel, the help overlay, a transient message and the scene error."""
+
+    def __init__(self, window: pyglet.window.Window) -> None:
+        self.window = window
+        self.batch = pyglet.graphics.Batch()
+        self.help_batch = pyglet.graphics.Batch()
+        self.show_hud = True
+        self.show_help = False
+        self.text = ""
+        self.error = ""
+        self.message = ""
+        self._message_until = 0.0
+        self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
+        self.label = pyglet.text.Label(
+            "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=460,
+            anchor_y="top", batch=self.batch,
+        )  # fmt: skip
+        self.error_label = pyglet.text.Label(
+            "", font_name=FONT, font_size=FONT_SIZE, color=ERROR_COLOR, multiline=True, width=900,
+            anchor_y="bottom",
+        )  # fmt: skip
+        self.message_label = pyglet.text.Label(
+            "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, anchor_y="bottom"
+        )
+        self.help_panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.help_batch)
+        self.help_label = pyglet.text.Label(
+            help_text(), font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=620,
+            anchor_x="center", anchor_y="center", batch=self.help_batch,
+        )  # fmt: skip
+        self.layout()
+
+    def layout(self) -> None:
+        """Place the labels for the window's current size."""
+        w, h = self.window.width, self.window.height
+        self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
+        self.error_label.width = max(w - 2 * MARGIN, 100)
+        self.error_label.x, self.error_label.y = MARGIN, MARGIN
+        self.message_label.x = MARGIN
+        self.message_label.y = MARGIN + (self.error_label.content_height + 6 if self.error else 0)
+        self._fit_panel()
+        self.help_label.x, self.help_label.y = w // 2, h // 2
+        hw, hh = self.help_label.content_width + 40, self.help_label.content_height + 30
+        self.help_panel.position = (w // 2 - hw // 2, h // 2 - hh // 2)
+        self.help_panel.width, self.help_panel.height = hw, hh
+
+    def _fit_panel(self) -> None:
+        h = self.window.height
+        pw, ph = self.label.content_width + 14, self.label.content_height + 10
+        self.panel.position = (MARGIN, h - MARGIN - ph)
+        self.panel.width, self.panel.height = pw, ph
+
+    def set_text(self, lines: list[str]) -> None:
+        text = "\n".join(lines)
+        if text != self.text:
+            self.text = text
+            self.label.text = text
+            self._fit_panel()
+
+    def set_error(self, error: str | None) -> None:
+        error = f"scene error: {error}" if error else ""
+        if error != self.error:
+            self.error = error
+            self.error_label.text = error
+            self.layout()
+
+    def flash(self, message: str, now: float) -> None:
+        """Show ``message`` for a few seconds."""
+        self.message = message
+        self.message_label.text = message
+        self._message_until = now + MESSAGE_SECONDS
+
+    def draw(self, now: float) -> None:
+        if self.show_hud:
+            self.batch.draw()
+        if self.error:
+            self.error_label.draw()
+        if self.message and now < self._message_until:
+            self.message_label.draw()
+        if self.show_help:
+            self.help_batch.draw()

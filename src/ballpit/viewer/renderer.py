@@ -1,0 +1,257 @@
+"""OpenGL 3.3 core renderer: planes, instanced balls and debug lines, drawn with PyOpenGL.
+
+Import this only after ``backend.use_window()`` or ``backend.use_headless()`` and with a GL context
+current. Per frame the CPU work is whole-array NumPy plus a handful of GL calls: the balls are one
+instance-buffer upload and one ``glDrawArraysInstanced`` whatever their number. Every draw goes through
+``DrawLog`` so tests and benchmarks can see exactly which draw calls a frame made.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from OpenGL import GL
+
+from .camera import Camera
+from .overlays import VERTEX_WIDTH
+from .shaders import Program
+
+BACKGROUND = (0.105, 0.125, 0.165)  # sRGB clear colour; fog fades to it
+FOG_DENSITY = 0.012  # 1/m: the ground is faint by 100 m and gone by 200 m
+GROUND_EXTENT = 600.0  # half size (m) of the quad drawn for an infinite plane
+NO_EDGE = 1.0e6  # "half size" given to the shader for infinite planes: no edge band
+BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), colour (3), spare
+PLANE_STRIDE = 13  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3)
+_FLOAT = 4
+
+
+@dataclass
+class DrawCall:
+    label: str
+    function: str
+    count: int
+    instances: int = 1
+
+
+@dataclass
+class DrawLog:
+    """Forwards draw calls to GL and records them for the current frame."""
+
+    calls: list[DrawCall] = field(default_factory=list)
+
+    def reset(self) -> None:
+        self.calls.clear()
+
+    def arrays(self, label: str, mode: int, first: int, count: int) -> None:
+        self.calls.append(DrawCall(label, "glDrawArrays", count))
+        GL.glDrawArrays(mode, first, count)
+
+    def arrays_instanced(self, label: str, mode: int, first: int, count: int, instances: int) -> None:
+        self.calls.append(DrawCall(label, "glDrawArraysInstanced", count, instances))
+        GL.glDrawArraysInstanced(mode, first, count, instances)
+
+    def count(self, label: str) -> int:
+        return sum(1 for c in self.calls if c.label == label)
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate vectors ``v`` (..., 3) by unit quaternions ``q`` (..., 4), scalar last."""
+    u, w = q[..., :3], q[..., 3:4]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def _offset(floats: int) -> ctypes.c_void_p:
+    return ctypes.c_void_p(floats * _FLOAT)
+
+
+def _attribute(index: int, size: int, stride_floats: int, offset_floats: int, divisor: int = 0) -> None:
+    GL.glEnableVertexAttribArray(index)
+    GL.glVertexAttribPointer(
+        index, size, GL.GL_FLOAT, GL.GL_FALSE, stride_floats * _FLOAT, _offset(offset_floats)
+    )
+    if divisor:
+        GL.glVertexAttribDivisor(index, divisor)
+
+
+class Renderer:
+    """Owns the GL programs and buffers of the 3-D view (not the HUD)."""
+
+    def __init__(self, shader_directory: object = None) -> None:
+        self.ball_program = Program("ball.vert", "ball.frag", shader_directory)
+        self.plane_program = Program("plane.vert", "plane.frag", shader_directory)
+        self.line_program = Program("line.vert", "line.frag", shader_directory)
+        self.draws = DrawLog()
+        self.background = np.array(BACKGROUND, dtype=np.float32)
+        self.fog_density = FOG_DENSITY
+        self.upload_seconds = 0.0
+        self.draw_seconds = 0.0
+
+        # balls: a static quad (4 corners, triangle strip) and the per-instance buffer
+        self.ball_vao = GL.glGenVertexArrays(1)
+        self.corner_vbo, self.instance_vbo = GL.glGenBuffers(2)
+        GL.glBindVertexArray(self.ball_vao)
+        corners = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.corner_vbo)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, corners.nbytes, corners, GL.GL_STATIC_DRAW)
+        _attribute(0, 2, 2, 0)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.instance_vbo)
+        _attribute(1, 4, BALL_STRIDE, 0, divisor=1)  # centre, radius
+        _attribute(2, 4, BALL_STRIDE, 4, divisor=1)  # orientation
+        _attribute(3, 4, BALL_STRIDE, 8, divisor=1)  # colour
+        self._instances = np.zeros((0, BALL_STRIDE), dtype=np.float32)
+        self.ball_count = 0
+
+        # planes: two triangles each, rebuilt only when the scene changes
+        self.plane_vao = GL.glGenVertexArrays(1)
+        self.plane_vbo = GL.glGenBuffers(1)
+        GL.glBindVertexArray(self.plane_vao)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
+        for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10)]):
+            _attribute(index, size, PLANE_STRIDE, offset)
+        self.plane_vertices = 0
+
+        # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
+        self.line_vao = GL.glGenVertexArrays(1)
+        self.line_vbo = GL.glGenBuffers(1)
+        GL.glBindVertexArray(self.line_vao)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.line_vbo)
+        _attribute(0, 3, VERTEX_WIDTH, 0)
+        _attribute(1, 4, VERTEX_WIDTH, 3)
+        self.world_line_vertices = 0
+        self.overlay_line_vertices = 0
+
+        GL.glBindVertexArray(0)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+
+    # ------------------------------------------------------------------ uploads
+    def set_planes(
+        self, centers: np.ndarray, orientations: np.ndarray, half_sizes: np.ndarray, colors: np.ndarray
+    ) -> None:
+        """Build the plane quads (call when the scene changes, not per frame)."""
+        centers = np.asarray(centers, dtype=float).reshape(-1, 3)
+        count = len(centers)
+        q = np.asarray(orientations, dtype=float).reshape(-1, 4)
+        half = np.asarray(half_sizes, dtype=float).reshape(-1, 2)
+        infinite = ~np.isfinite(half)
+        drawn_half = np.where(infinite, GROUND_EXTENT, half)
+        shader_half = np.where(infinite, NO_EDGE, half)
+        u = rotate(q, np.broadcast_to([1.0, 0.0, 0.0], (count, 3)))
+        n = rotate(q, np.broadcast_to([0.0, 1.0, 0.0], (count, 3)))
+        v = rotate(q, np.broadcast_to([0.0, 0.0, 1.0], (count, 3)))
+        # corners in plane-local units, two counter-clockwise triangles seen from the normal's side
+        local = np.array([[-1, -1], [-1, 1], [1, 1], [-1, -1], [1, 1], [1, -1]], dtype=float)
+        local = local[None] * drawn_half[:, None, :]  # (P, 6, 2)
+        positions = centers[:, None, :] + local[..., :1] * u[:, None, :] + local[..., 1:] * v[:, None, :]
+        data = np.empty((count, 6, PLANE_STRIDE), dtype=np.float32)
+        data[..., 0:3] = positions
+        data[..., 3:5] = local
+        data[..., 5:7] = shader_half[:, None, :]
+        data[..., 7:10] = n[:, None, :]
+        data[..., 10:13] = np.asarray(colors, dtype=float).reshape(-1, 3)[:, None, :]
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STATIC_DRAW)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+        self.plane_vertices = count * 6
+
+    def upload_balls(
+        self, positions: np.ndarray, orientations: np.ndarray, radii: np.ndarray, colors: np.ndarray
+    ) -> None:
+        """Fill the per-instance buffer from whole arrays: one ``glBufferData`` for all balls."""
+        started = time.perf_counter()
+        n = len(positions)
+        if self._instances.shape[0] != n:
+            self._instances = np.zeros((n, BALL_STRIDE), dtype=np.float32)
+            self._instances[:, 11] = 1.0
+        inst = self._instances
+        inst[:, 0:3] = positions
+        inst[:, 3] = radii
+        inst[:, 4:8] = orientations
+        inst[:, 8:11] = colors
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.instance_vbo)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, inst.nbytes, inst if n else None, GL.GL_STREAM_DRAW)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+        self.ball_count = n
+        self.upload_seconds = time.perf_counter() - started
+
+    def upload_lines(self, world_lines: np.ndarray, overlay_lines: np.ndarray) -> None:
+        """Line vertices (M, 7) for this frame: depth-tested world lines, then always-visible overlays."""
+        data = np.concatenate([world_lines, overlay_lines]).astype(np.float32, copy=False)
+        self.world_line_vertices = len(world_lines)
+        self.overlay_line_vertices = len(overlay_lines)
+        if len(data):
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.line_vbo)
+            GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+
+    # ------------------------------------------------------------------ drawing
+    def _common_uniforms(self, program: Program, view_projection: np.ndarray, eye: np.ndarray) -> None:
+        program.use()
+        program.set("u_view_projection", view_projection)
+        program.set("u_eye", eye)
+        program.set("u_background", self.background)
+        program.set("u_fog_density", self.fog_density)
+
+    def draw(self, camera: Camera, width: int, height: int, multisample: bool = False) -> None:
+        """Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport."""
+        started = time.perf_counter()
+        self.draws.reset()
+        width, height = max(int(width), 1), max(int(height), 1)
+        view_projection = camera.view_projection(width / height)
+        eye = np.asarray(camera.position, dtype=np.float32)
+
+        GL.glViewport(0, 0, width, height)
+        GL.glClearColor(*self.background, 1.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LEQUAL)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glDisable(GL.GL_CULL_FACE)  # planes are two-sided; ball quads face the camera anyway
+        GL.glDisable(GL.GL_BLEND)
+
+        if self.plane_vertices:
+            self._common_uniforms(self.plane_program, view_projection, eye)
+            GL.glBindVertexArray(self.plane_vao)
+            self.draws.arrays("planes", GL.GL_TRIANGLES, 0, self.plane_vertices)
+
+        if self.ball_count:
+            self._common_uniforms(self.ball_program, view_projection, eye)
+            if multisample:
+                GL.glEnable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
+            GL.glBindVertexArray(self.ball_vao)
+            self.draws.arrays_instanced("balls", GL.GL_TRIANGLE_STRIP, 0, 4, self.ball_count)
+            if multisample:
+                GL.glDisable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
+
+        if self.world_line_vertices or self.overlay_line_vertices:
+            self.line_program.use()
+            self.line_program.set("u_view_projection", view_projection)
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
+            GL.glDepthMask(GL.GL_FALSE)
+            GL.glBindVertexArray(self.line_vao)
+            if self.world_line_vertices:
+                self.draws.arrays("world lines", GL.GL_LINES, 0, self.world_line_vertices)
+            if self.overlay_line_vertices:
+                GL.glDisable(GL.GL_DEPTH_TEST)
+                self.draws.arrays(
+                    "overlay lines", GL.GL_LINES, self.world_line_vertices, self.overlay_line_vertices
+                )
+            GL.glDepthMask(GL.GL_TRUE)
+
+        # leave the state pyglet's own drawing (the HUD) expects
+        GL.glBindVertexArray(0)
+        GL.glUseProgram(0)
+        GL.glDisable(GL.GL_DEPTH_TEST)
+        GL.glDisable(GL.GL_BLEND)
+        self.draw_seconds = time.perf_counter() - started
+
+    def delete(self) -> None:
+        """Free the GL objects (the context must be current)."""
+        for program in (self.ball_program, self.plane_program, self.line_program):
+            program.delete()
+        GL.glDeleteBuffers(4, [self.corner_vbo, self.instance_vbo, self.plane_vbo, self.line_vbo])
+        GL.glDeleteVertexArrays(3, [self.ball_vao, self.plane_vao, self.line_vao])

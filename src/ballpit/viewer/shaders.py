@@ -1,0 +1,149 @@
+"""Loading GLSL from the ``shaders/`` directory (package ``ballpit.shaders``), compiling and linking it.
+
+Sources may pull in shared code with ``#include "name.glsl"``; the loader splices the file in between
+``#line`` directives so the driver's log still points at the right file and line (GLSL numbers source
+strings: 0 is the main file, 1, 2, ... the includes in order). Compile and link failures raise
+``ShaderError`` naming the file and quoting the driver's log.
+"""
+
+from __future__ import annotations
+
+import re
+from importlib import resources
+from importlib.resources.abc import Traversable
+from pathlib import Path
+
+import numpy as np
+
+_INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
+
+
+class ShaderError(RuntimeError):
+    """A shader failed to load, compile or link."""
+
+
+def shader_dir() -> Traversable:
+    """Where the GLSL files live: the installed ``ballpit.shaders`` package, or the source checkout's
+    ``shaders/`` (an editable install cannot import a namespace package inside a regular one)."""
+    try:
+        return resources.files("ballpit.shaders")
+    except ModuleNotFoundError:
+        checkout = Path(__file__).resolve().parents[3] / "shaders"
+        if checkout.is_dir():
+            return checkout
+        raise ShaderError(
+            f"cannot find the ballpit shaders (no package ballpit.shaders, no {checkout})"
+        ) from None
+
+
+def load_source(name: str, directory: Traversable | Path | None = None) -> tuple[str, list[str]]:
+    """The text of shader ``name`` with its includes spliced in, and the file names by source-string
+    number (index 0 is ``name``)."""
+    directory = shader_dir() if directory is None else directory
+    files: list[str] = [name]
+
+    def read(file: str) -> str:
+        path = directory / file
+        try:
+            return path.read_text(encoding="utf-8")
+        except (FileNotFoundError, OSError) as exc:
+            raise ShaderError(f"cannot read shader {file} from {directory}: {exc}") from None
+
+    def expand(file: str, number: int) -> str:
+        out: list[str] = []
+        for lineno, line in enumerate(read(file).splitlines(), start=1):
+            match = _INCLUDE.match(line)
+            if match is None:
+                out.append(line)
+                continue
+            included = match.group(1)
+            files.append(included)
+            out.append(f"#line 1 {len(files) - 1}")
+            out.append(expand(included, len(files) - 1))
+            out.append(f"#line {lineno + 1} {number}")
+        return "\n".join(out) + "\n"
+
+    return expand(name, 0), files
+
+
+def _describe_sources(files: list[str]) -> str:
+    if len(files) == 1:
+        return ""
+    return " (source strings: " + ", ".join(f"{i} = {f}" for i, f in enumerate(files)) + ")"
+
+
+def compile_shader(name: str, directory: Traversable | Path | None = None) -> int:
+    """Compile one shader file (its stage from the suffix: .vert or .frag); returns the GL name."""
+    from OpenGL import GL
+
+    stages = {".vert": GL.GL_VERTEX_SHADER, ".frag": GL.GL_FRAGMENT_SHADER}
+    suffix = Path(name).suffix
+    if suffix not in stages:
+        raise ShaderError(f"{name}: unknown shader stage (expected .vert or .frag)")
+    source, files = load_source(name, directory)
+    shader = GL.glCreateShader(stages[suffix])
+    GL.glShaderSource(shader, source)
+    GL.glCompileShader(shader)
+    if not GL.glGetShaderiv(shader, GL.GL_COMPILE_STATUS):
+        log = GL.glGetShaderInfoLog(shader)
+        log = log.decode(errors="replace") if isinstance(log, bytes) else str(log)
+        GL.glDeleteShader(shader)
+        raise ShaderError(f"shader {name} failed to compile{_describe_sources(files)}:\n{log.strip()}")
+    return shader
+
+
+class Program:
+    """A linked vertex + fragment program with cached uniform locations."""
+
+    def __init__(self, vertex: str, fragment: str, directory: Traversable | Path | None = None) -> None:
+        from OpenGL import GL
+
+        self.name = f"{vertex} + {fragment}"
+        shaders = [compile_shader(vertex, directory), compile_shader(fragment, directory)]
+        program = GL.glCreateProgram()
+        for shader in shaders:
+            GL.glAttachShader(program, shader)
+        GL.glLinkProgram(program)
+        for shader in shaders:
+            GL.glDetachShader(program, shader)
+            GL.glDeleteShader(shader)
+        if not GL.glGetProgramiv(program, GL.GL_LINK_STATUS):
+            log = GL.glGetProgramInfoLog(program)
+            log = log.decode(errors="replace") if isinstance(log, bytes) else str(log)
+            GL.glDeleteProgram(program)
+            raise ShaderError(f"shader program {self.name} failed to link:\n{log.strip()}")
+        self.id = program
+        self._locations: dict[str, int] = {}
+
+    def use(self) -> None:
+        from OpenGL import GL
+
+        GL.glUseProgram(self.id)
+
+    def location(self, uniform: str) -> int:
+        if uniform not in self._locations:
+            from OpenGL import GL
+
+            self._locations[uniform] = GL.glGetUniformLocation(self.id, uniform)
+        return self._locations[uniform]
+
+    def set(self, uniform: str, value: object) -> None:
+        """Set a float, vec2/3/4 or mat4 uniform from a number or array (the program must be in use)."""
+        from OpenGL import GL
+
+        loc = self.location(uniform)
+        if loc < 0:
+            return  # optimised away by the driver
+        arr = np.asarray(value, dtype=np.float32)
+        if arr.shape == (4, 4):
+            GL.glUniformMatrix4fv(loc, 1, GL.GL_FALSE, np.ascontiguousarray(arr))
+        elif arr.ndim == 0:
+            GL.glUniform1f(loc, float(arr))
+        else:
+            setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv, 4: GL.glUniform4fv}[arr.shape[-1]]
+            setter(loc, 1, arr)
+
+    def delete(self) -> None:
+        from OpenGL import GL
+
+        GL.glDeleteProgram(self.id)

@@ -1,0 +1,309 @@
+"""The viewer's simulation driver: fixed timestep, interpolation, run state, reset and reload.
+
+Physics advances in fixed steps of the scene's timestep from an accumulator fed by real time (Glenn
+Fiedler, "Fix Your Timestep!"). Frames render the state interpolated between the last two steps, so
+motion is smooth at any frame rate. A frame never steps for more than ``step_budget`` seconds of wall
+time nor more than ``MAX_FRAME_SECONDS`` of real time: when physics cannot keep up, the backlog is
+dropped (the real-time factor falls below the time scale) instead of spiralling.
+
+No GL here, and nothing per ball in Python: everything works on whole arrays.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import sys
+import time
+from collections.abc import Callable
+from enum import Enum
+from pathlib import Path
+
+import numpy as np
+
+from .appearance import Appearance, appearance_of
+
+MAX_FRAME_SECONDS = 0.25
+TRAIL_POINT_BUDGET = 200_000  # trail samples kept over all balls
+TRAIL_MAX_SAMPLES = 120
+TRAIL_INTERVAL = 1.0 / 30.0  # simulated seconds between trail samples
+STATS_WINDOW = 0.5  # wall seconds over which steps/s and the real-time factor are measured
+
+
+class Phase(Enum):
+    WAITING = "waiting: press X to drop"
+    RUNNING = "running"
+    PAUSED = "paused: Space resumes, N steps"
+
+
+def _default_loader(path: Path) -> object:
+    import ballpit
+
+    return ballpit.load_scene(path)
+
+
+def _file_signature(path: Path | None) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path) if path is not None else None
+    except OSError:
+        return None
+    return None if st is None else (st.st_mtime_ns, st.st_size)
+
+
+def _describe(exc: BaseException) -> str:
+    return str(exc).strip() or type(exc).__name__
+
+
+class Trails:
+    """A ring buffer of recent ball positions, sized so all balls together keep a bounded number."""
+
+    def __init__(self, count: int) -> None:
+        self.length = int(np.clip(TRAIL_POINT_BUDGET // max(count, 1), 2, TRAIL_MAX_SAMPLES))
+        self._samples = np.zeros((self.length, count, 3), dtype=np.float32)
+        self._head = 0
+        self.filled = 0
+        self.last_time = -np.inf
+
+    def record(self, positions: np.ndarray, sim_time: float) -> None:
+        if sim_time - self.last_time < TRAIL_INTERVAL * 0.999:
+            return
+        self._samples[self._head] = positions
+        self._head = (self._head + 1) % self.length
+        self.filled = min(self.filled + 1, self.length)
+        self.last_time = sim_time
+
+    def ordered(self) -> np.ndarray:
+        """(filled, N, 3) samples, oldest first."""
+        order = (self._head - self.filled + np.arange(self.filled)) % self.length
+        return self._samples[order]
+
+
+class Simulation:
+    """A World being watched: the run phase, the fixed-step clock and what the viewer draws from it."""
+
+    def __init__(
+        self,
+        world: object,
+        path: Path | None = None,
+        loader: Callable[[Path], object] | None = None,
+        step_budget: float = 0.05,
+        clock: Callable[[], float] = time.perf_counter,
+    ) -> None:
+        self.loader = loader or _default_loader
+        self.step_budget = step_budget
+        self.clock = clock
+        self.time_scale = 1.0
+        self.error: str | None = None
+        self.message: str = ""
+        self.generation = 0  # bumps whenever the world is replaced, so the renderer rebuilds geometry
+        self.dropped_seconds = 0.0  # simulated time skipped because physics could not keep up
+        self._install(world, path)
+
+    # ------------------------------------------------------------------ world management
+    def _install(self, world: object, path: Path | None) -> None:
+        self.world = world
+        self.appearance: Appearance = appearance_of(world, path)
+        self.path = self.appearance.path
+        self.initial = copy.deepcopy(world)
+        self._signature = _file_signature(self.path)
+        spheres = world.spheres
+        self.masses = np.array(spheres.masses, dtype=float)
+        self.inertias = np.array([s.inertia for s in spheres], dtype=float)  # once per world, not per frame
+        self._reset_dynamics()
+        self.generation += 1
+
+    def _reset_dynamics(self) -> None:
+        spheres = self.world.spheres
+        self.phase = Phase.WAITING
+        self.accumulator = 0.0
+        self.alpha = 1.0
+        self.prev_positions = np.array(spheres.positions, dtype=float)
+        self.prev_orientations = np.array(spheres.orientations, dtype=float)
+        self.contacts = None  # Contacts of the last frame that stepped
+        self.last_step_contacts = 0
+        self.trails = Trails(len(spheres))
+        self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+        self.steps_total = 0
+        self.steps_per_second = 0.0
+        self.real_time_factor = 0.0
+        self._stats_wall = 0.0
+        self._stats_steps = 0
+        self._stats_sim = 0.0
+
+    @property
+    def timestep(self) -> float:
+        return self.appearance.timestep
+
+    @property
+    def ball_count(self) -> int:
+        return len(self.world.spheres)
+
+    # ------------------------------------------------------------------ controls
+    def start(self) -> None:
+        """X: start the drop (only from the waiting state)."""
+        if self.phase is Phase.WAITING:
+            self.phase = Phase.RUNNING
+            self.accumulator = 0.0
+            self.message = "dropped"
+
+    def toggle_pause(self) -> None:
+        """Space: pause a running simulation or resume a paused one."""
+        if self.phase is Phase.RUNNING:
+            self.phase = Phase.PAUSED
+            self.alpha = 1.0
+            self.message = "paused"
+        elif self.phase is Phase.PAUSED:
+            self.phase = Phase.RUNNING
+            self.accumulator = 0.0
+            self.message = "resumed"
+        else:
+            self.message = "press X to start the drop"
+
+    def step_once(self) -> None:
+        """N / →: one fixed step, only while paused."""
+        if self.phase is not Phase.PAUSED:
+            self.message = "N steps only while paused (Space pauses)"
+            return
+        contacts = []
+        self._step(contacts)
+        self._finish_steps(contacts)
+        self.alpha = 1.0
+
+    def reset(self) -> None:
+        """R: back to the initial state, waiting for X again. The live integrator choice is kept."""
+        integrator = self.world.integrator
+        self.world = copy.deepcopy(self.initial)
+        self.world.integrator = integrator
+        self._reset_dynamics()
+        self.message = "reset: press X to drop"
+
+    def set_integrator(self, name: str) -> None:
+        self.world.integrator = name
+        self.message = f"integrator {name.upper()}"
+
+    def faster(self) -> None:
+        from .controls import faster
+
+        self.time_scale = faster(self.time_scale)
+        self.message = f"time ×{self.time_scale:g}"
+
+    def slower(self) -> None:
+        from .controls import slower
+
+        self.time_scale = slower(self.time_scale)
+        self.message = f"time ×{self.time_scale:g}"
+
+    def reload(self) -> bool:
+        """Ctrl+R / F5 / file saved: load the file again. On any error keep the last good world running,
+        remember the error for the HUD and print it."""
+        if self.path is None:
+            self.error = "no scene file to reload (this world was built in code)"
+            return False
+        self._signature = _file_signature(self.path)
+        try:
+            world = self.loader(self.path)
+        except Exception as exc:  # any failure: the viewer must stay up with the old world
+            self.error = f"reload of {self.path.name} failed: {_describe(exc)}"
+            print(f"ballpit: {self.error} (keeping the last good scene)", file=sys.stderr, flush=True)
+            return False
+        self._install(world, self.path)
+        self.error = None
+        self.message = f"reloaded {self.path.name}: press X to drop"
+        return True
+
+    def file_changed(self) -> bool:
+        """True once each time the scene file's modification time or size changes."""
+        if self.path is None:
+            return False
+        signature = _file_signature(self.path)
+        if signature is None or signature == self._signature:
+            return False
+        self._signature = signature
+        return True
+
+    # ------------------------------------------------------------------ time
+    def advance(self, frame_seconds: float) -> int:
+        """Feed one frame's real time to the accumulator and take the fixed steps it pays for.
+
+        Returns the number of steps taken.
+        """
+        frame_seconds = max(0.0, float(frame_seconds))
+        steps = 0
+        if self.phase is Phase.RUNNING:
+            dt = self.timestep
+            self.accumulator += min(frame_seconds, MAX_FRAME_SECONDS) * self.time_scale
+            started = self.clock()
+            contacts: list = []
+            while self.accumulator >= dt and self.phase is Phase.RUNNING:
+                if steps > 0 and self.clock() - started > self.step_budget:
+                    # Physics is slower than real time: drop the backlog rather than spiral.
+                    dropped = self.accumulator - self.accumulator % dt
+                    self.dropped_seconds += dropped
+                    self.accumulator -= dropped
+                    break
+                self._step(contacts)
+                self.accumulator -= dt
+                steps += 1
+            self._finish_steps(contacts)
+            self.alpha = min(self.accumulator / dt, 1.0) if self.phase is Phase.RUNNING else 1.0
+        self._update_stats(frame_seconds, steps)
+        return steps
+
+    def _step(self, contacts: list) -> None:
+        spheres = self.world.spheres
+        self.prev_positions[:] = spheres.positions
+        self.prev_orientations[:] = spheres.orientations
+        try:
+            result = self.world.step(self.timestep)
+        except Exception as exc:  # a physics failure pauses the viewer instead of killing it
+            self.phase = Phase.PAUSED
+            self.error = f"physics step failed: {_describe(exc)}"
+            print(f"ballpit: {self.error}", file=sys.stderr, flush=True)
+            return
+        contacts.append(result)
+        self.last_step_contacts = len(result)
+        self.steps_total += 1
+        self._stats_steps += 1
+        self._stats_sim += self.timestep
+        self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+
+    def _finish_steps(self, contacts: list) -> None:
+        if contacts:
+            from ballpit import Contacts
+
+            self.contacts = Contacts.concatenate(contacts)
+
+    def _update_stats(self, frame_seconds: float, steps: int) -> None:
+        self._stats_wall += frame_seconds
+        if self._stats_wall >= STATS_WINDOW:
+            self.steps_per_second = self._stats_steps / self._stats_wall
+            self.real_time_factor = self._stats_sim / self._stats_wall
+            self._stats_wall = 0.0
+            self._stats_steps = 0
+            self._stats_sim = 0.0
+
+    # ------------------------------------------------------------------ what to draw
+    def render_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (N, 3) and orientations (N, 4) interpolated ``alpha`` of the way from the previous
+        step to the current one (positions lerped, quaternions nlerped along the short arc)."""
+        spheres = self.world.spheres
+        pos = np.asarray(spheres.positions, dtype=float)
+        quat = np.asarray(spheres.orientations, dtype=float)
+        a = self.alpha
+        if a >= 1.0 or self.phase is not Phase.RUNNING:
+            return pos, quat
+        positions = self.prev_positions + (pos - self.prev_positions) * a
+        prev_q = self.prev_orientations
+        sign = np.where(np.einsum("ij,ij->i", prev_q, quat) < 0.0, -1.0, 1.0)[:, None]
+        q = prev_q * (1.0 - a) + quat * sign * a
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        return positions, q
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy of all balls, J."""
+        spheres = self.world.spheres
+        v = np.asarray(spheres.velocities)
+        w = np.asarray(spheres.angular_velocities)
+        return 0.5 * float(
+            self.masses @ np.einsum("ij,ij->i", v, v) + self.inertias @ np.einsum("ij,ij->i", w, w)
+        )
