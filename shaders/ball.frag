@@ -11,6 +11,7 @@ flat in vec4 v_orientation;
 flat in vec3 v_color;
 
 uniform mat4 u_view_projection;
+uniform float u_multisample;   // 1: edge coverage goes to alpha-to-coverage; 0: a hard edge at r
 
 out vec4 frag_color;
 
@@ -35,7 +36,9 @@ void main() {
     vec3 closest = oc - b * ray;                 // centre → closest point of the ray
     float miss = length(closest);                // distance of the ray from the centre
     float aa = max(fwidth(miss), 1e-6);
-    if (miss > r + aa) discard;
+    // coverage of this pixel by the silhouette (for alpha-to-coverage when multisampling)
+    float coverage = clamp((r - miss) / aa + 0.5, 0.0, 1.0);
+    if (u_multisample > 0.5 ? coverage <= 0.0 : miss > r) discard;
     float h = sqrt(max(r * r - miss * miss, 0.0));
     float t = -b - h;
     vec3 hit = u_eye + ray * t;
@@ -58,7 +61,5 @@ void main() {
     vec3 albedo = mix(v_color, WHITE, white_amount);
 
     vec3 color = fog(shade(albedo, n, hit, 48.0, 0.35), hit);
-    // coverage for alpha-to-coverage when multisampling; opaque otherwise
-    float coverage = clamp((r - miss) / aa + 0.5, 0.0, 1.0);
-    frag_color = vec4(color, coverage);
+    frag_color = vec4(color, u_multisample > 0.5 ? coverage : 1.0);
 }

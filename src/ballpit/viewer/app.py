@@ -22,17 +22,10 @@ FRAME_INTERVAL = 1.0 / 120.0  # redraw rate asked of pyglet's loop (vsync may ca
 
 
 def default_scene() -> Path:
-    """The bundled slopes demo."""
-    try:
-        from importlib import resources
+    """The bundled slopes demo (``ballpit.scenes/slopes.toml``)."""
+    from ballpit.scene import default_scene_path
 
-        path = resources.files("ballpit.scenes") / "slopes.toml"
-        if path.is_file():
-            return Path(str(path))
-    except ModuleNotFoundError:
-        pass
-    # an editable install cannot import the namespace package; use the checkout's scenes/
-    return Path(__file__).resolve().parents[3] / "scenes" / "slopes.toml"
+    return default_scene_path()
 
 
 def _is_no_display(exc: BaseException) -> bool:
@@ -289,6 +282,15 @@ class Viewer:
         print(f"screenshot saved to {self.last_screenshot}", flush=True)
         self.hud.flash(f"screenshot saved to {self.last_screenshot}", time.perf_counter())
         return self.last_screenshot
+
+    def pump(self, dt: float | None = None) -> None:
+        """One turn of the event loop by hand: deliver queued window events, draw a frame, flip.
+        (pyglet queues events dispatched before its loop runs; this is what tests drive.)"""
+        self.window.switch_to()
+        self.window.dispatch_events()
+        if not self.closed:
+            self.frame(dt)
+            self.window.flip()
 
     def run(self) -> None:
         """pyglet's event loop until the window closes."""

@@ -32,12 +32,21 @@ PALETTE = np.array(
 # Plane colour by restitution: dead (0) slate blue → medium green → bouncy (≥1) orange.
 _RESTITUTION_STOPS = np.array([0.0, 0.5, 1.0])
 _RESTITUTION_COLORS = np.array([[0.29, 0.36, 0.50], [0.30, 0.56, 0.42], [0.93, 0.55, 0.20]])
+GROUND_COLOR = (0.55, 0.57, 0.60)  # infinite planes: a neutral ground, as scene files default it
 
 
 def restitution_colors(restitutions: object) -> np.ndarray:
     """(P, 3) plane colours showing bounciness: slate blue at 0, green at 0.5, orange at 1 and above."""
     e = np.clip(np.asarray(restitutions, dtype=float).reshape(-1), 0.0, 1.0)
     return np.stack([np.interp(e, _RESTITUTION_STOPS, _RESTITUTION_COLORS[:, k]) for k in range(3)], axis=-1)
+
+
+def default_plane_colors(planes: object) -> np.ndarray:
+    """Finite planes coloured by restitution, infinite ones (the ground) neutral grey."""
+    colors = restitution_colors(planes.restitutions)  # type: ignore[attr-defined]
+    infinite = np.isinf(np.asarray(planes.half_sizes)).all(axis=1)  # type: ignore[attr-defined]
+    colors[infinite] = GROUND_COLOR
+    return colors
 
 
 @dataclass
@@ -85,8 +94,6 @@ def appearance_of(world: object, path: Path | None = None) -> Appearance:
             DEFAULT_CAMERA_LOOK_AT if camera_look_at is None else camera_look_at, dtype=float
         ),
         sphere_colors=_colors(getattr(info, "sphere_colors", None), n, palette),
-        plane_colors=_colors(
-            getattr(info, "plane_colors", None), len(planes), restitution_colors(planes.restitutions)
-        ),
+        plane_colors=_colors(getattr(info, "plane_colors", None), len(planes), default_plane_colors(planes)),
         timestep=float(timestep),
     )

@@ -3,7 +3,7 @@
 ``render`` switches this process to headless GL (it cannot open a window afterwards; see backend.py),
 starts the drop at once and steps the physics exactly 1/fps of simulated time per frame, whatever the
 wall time. Output by ``out``: ``*.gif`` an animated GIF, ``*.png`` one PNG of the last frame, a
-directory (existing, or a path ending in ``/``) numbered PNG frames ``frame_0000.png``, ...
+directory (existing, ending in ``/`` or without a suffix) numbered PNG frames ``frame_0000.png``, ...
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ class Offscreen:
 
 
 def _output_kind(out: Path, raw: str) -> str:
-    if raw.endswith(("/", os.sep)) or out.is_dir():
+    if raw.endswith(("/", os.sep)) or out.is_dir() or not out.suffix:
         return "frames"
     suffix = out.suffix.lower()
     if suffix in (".gif", ".png"):

@@ -20,7 +20,7 @@ from .overlays import VERTEX_WIDTH
 from .shaders import Program
 
 BACKGROUND = (0.105, 0.125, 0.165)  # sRGB clear colour; fog fades to it
-FOG_DENSITY = 0.012  # 1/m: the ground is faint by 100 m and gone by 200 m
+FOG_DENSITY = 0.02  # 1/m: fog is light at 20 m, the ground faint by 60 m and gone by 100 m
 GROUND_EXTENT = 600.0  # half size (m) of the quad drawn for an infinite plane
 NO_EDGE = 1.0e6  # "half size" given to the shader for infinite planes: no edge band
 BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), colour (3), spare
@@ -219,6 +219,7 @@ class Renderer:
 
         if self.ball_count:
             self._common_uniforms(self.ball_program, view_projection, eye)
+            self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
             if multisample:
                 GL.glEnable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
             GL.glBindVertexArray(self.ball_vao)

@@ -1,0 +1,92 @@
+"""Fixtures for the viewer tests.
+
+The renderer tests draw offscreen through pyglet's headless EGL mode in this pytest process (the
+``offscreen`` fixture switches the process to headless GL the first time it is used). The window tests
+never open a window here: they run real windows in subprocesses under an Xvfb server of their own.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ballpit
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def offscreen():
+    """A headless GL context with a 200×150 single-sample framebuffer and the real Renderer."""
+    from ballpit.viewer.render import Offscreen
+
+    screen = Offscreen((200, 150), samples=0)
+    yield screen
+    screen.close()
+
+
+def free_display() -> int:
+    """An X display number nobody is using."""
+    for n in range(90, 190):
+        if not Path(f"/tmp/.X{n}-lock").exists() and not Path(f"/tmp/.X11-unix/X{n}").exists():
+            return n
+    raise RuntimeError("no free X display number between :90 and :189")
+
+
+@pytest.fixture(scope="session")
+def xvfb():
+    """Start an Xvfb server for the window tests; yields its DISPLAY string (e.g. ":90")."""
+    if shutil.which("Xvfb") is None:
+        pytest.skip("Xvfb is not installed (apt-get install xvfb); .ci/run installs it")
+    last_error = ""
+    for _ in range(3):
+        n = free_display()
+        proc = subprocess.Popen(
+            ["Xvfb", f":{n}", "-screen", "0", "1280x720x24", "-nolisten", "tcp"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        socket = Path(f"/tmp/.X11-unix/X{n}")
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and proc.poll() is None and not socket.exists():
+            time.sleep(0.05)
+        if proc.poll() is None and socket.exists():
+            try:
+                yield f":{n}"
+            finally:
+                proc.terminate()
+                try:
+                    proc.wait(timeout=5)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+            return
+        proc.kill()
+        last_error = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+    pytest.fail(f"Xvfb did not start: {last_error}")
+
+
+def subprocess_env(display: str | None) -> dict[str, str]:
+    """The environment for a viewer subprocess: this interpreter's, with DISPLAY set or removed."""
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("DISPLAY", "PYOPENGL_PLATFORM", "WAYLAND_DISPLAY")
+    }
+    if display is not None:
+        env["DISPLAY"] = display
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO / "src"), env.get("PYTHONPATH")]))
+    return env
+
+
+def line_of_balls(n: int = 5, y: float = 6.0, gravity: tuple = (0.0, -9.81, 0.0)) -> ballpit.World:
+    """A World built in code: a ground, one slope and ``n`` balls in a row at height ``y``."""
+    world = ballpit.World(gravity=gravity)
+    world.add_plane(position=(0.0, 0.0, 0.0))
+    world.add_plane(position=(0.0, 2.0, 0.0), rotation=(0.0, 0.0, 20.0), size=4.0, restitution=0.6)
+    xs = np.linspace(-3.0, 3.0, n) if n > 1 else np.zeros(1)
+    world.add_spheres(np.column_stack([xs, np.full(n, y), np.zeros(n)]), radius=0.3)
+    return world

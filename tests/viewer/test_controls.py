@@ -1,0 +1,99 @@
+"""The input → action mapping: every binding of design.md's "Viewer controls" table, without GL."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ballpit.viewer import controls
+from ballpit.viewer.controls import Action, action_for_key
+
+DESIGN_TABLE = {
+    "X": Action.START,
+    "SPACE": Action.PAUSE,
+    "N": Action.STEP,
+    "RIGHT": Action.STEP,
+    "R": Action.RESET,
+    "F5": Action.RELOAD,
+    "_1": Action.EULER,
+    "_2": Action.RK2,
+    "_3": Action.RK4,
+    "EQUAL": Action.FASTER,  # "+" arrives as Shift+EQUAL
+    "PLUS": Action.FASTER,
+    "NUM_ADD": Action.FASTER,
+    "MINUS": Action.SLOWER,
+    "NUM_SUBTRACT": Action.SLOWER,
+    "TAB": Action.CAPTURE_MOUSE,
+    "ESCAPE": Action.ESCAPE,
+    "C": Action.CONTACTS,
+    "V": Action.VELOCITIES,
+    "T": Action.TRAILS,
+    "H": Action.HUD,
+    "F1": Action.HELP,
+    "F12": Action.SCREENSHOT,
+}
+
+
+@pytest.mark.parametrize(("name", "action"), DESIGN_TABLE.items())
+def test_each_key_of_the_design_table_maps_to_its_action(name, action):
+    assert action_for_key(name) is action
+
+
+def test_ctrl_r_reloads_while_plain_r_resets():
+    assert action_for_key("R", ctrl=True) is Action.RELOAD
+    assert action_for_key("R") is Action.RESET
+
+
+def test_unbound_keys_and_other_ctrl_chords_do_nothing():
+    assert action_for_key("Z") is None
+    assert action_for_key("X", ctrl=True) is None
+
+
+def test_number_keys_choose_the_integrators_by_name():
+    names = [controls.INTEGRATOR_ACTIONS[action_for_key(k)] for k in ("_1", "_2", "_3")]
+    assert names == ["euler", "rk2", "rk4"]
+
+
+def test_fly_keys_give_unit_camera_relative_directions():
+    assert np.allclose(controls.fly_direction({"W"}), [0, 0, 1])
+    assert np.allclose(controls.fly_direction({"S"}), [0, 0, -1])
+    assert np.allclose(controls.fly_direction({"A"}), [-1, 0, 0])
+    assert np.allclose(controls.fly_direction({"D"}), [1, 0, 0])
+    assert np.allclose(controls.fly_direction({"Q"}), [0, -1, 0])
+    assert np.allclose(controls.fly_direction({"E"}), [0, 1, 0])
+    diagonal = controls.fly_direction({"W", "D", "X"})
+    assert np.allclose(diagonal, [np.sqrt(0.5), 0, np.sqrt(0.5)])
+    assert np.allclose(controls.fly_direction({"W", "S"}), 0)
+
+
+def test_shift_flies_faster():
+    assert controls.fly_speed_multiplier({"W"}) == 1.0
+    assert controls.fly_speed_multiplier({"W", "LSHIFT"}) == controls.SHIFT_SPEEDUP
+    assert controls.fly_speed_multiplier({"RSHIFT"}) == controls.SHIFT_SPEEDUP
+
+
+def test_scrolling_changes_fly_speed_within_bounds():
+    assert controls.scrolled_fly_speed(4.0, 1) == pytest.approx(4.0 * controls.SCROLL_FACTOR)
+    assert controls.scrolled_fly_speed(4.0, -2) == pytest.approx(4.0 / controls.SCROLL_FACTOR**2)
+    assert controls.scrolled_fly_speed(4.0, 1000) == controls.FLY_SPEED_RANGE[1]
+    assert controls.scrolled_fly_speed(4.0, -1000) == controls.FLY_SPEED_RANGE[0]
+
+
+def test_time_scale_doubles_and_halves_within_bounds():
+    assert controls.faster(1.0) == 2.0
+    assert controls.slower(1.0) == 0.5
+    assert controls.faster(controls.TIME_SCALE_RANGE[1]) == controls.TIME_SCALE_RANGE[1]
+    assert controls.slower(controls.TIME_SCALE_RANGE[0]) == controls.TIME_SCALE_RANGE[0]
+
+
+def test_escape_releases_a_captured_mouse_before_quitting():
+    assert controls.escape_outcome(mouse_captured=True) == "release"
+    assert controls.escape_outcome(mouse_captured=False) == "quit"
+
+
+def test_help_lists_every_control_of_the_design_table():
+    keys = " ".join(k for k, _ in controls.HELP)
+    for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1 / 2 / 3", "+ / −", "W A S D", "Q E",
+                  "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12"):  # fmt: skip
+        assert label in keys, label
+    assert "scroll" in " ".join(w for _, w in controls.HELP)
