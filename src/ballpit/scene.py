@@ -45,11 +45,11 @@ PALETTE = (
     "#00c9a7",
     "#ff8c42",
 )
-# Default plane colours: unbounded planes are a neutral floor; finite ones shade from a dull slate
-# (dead, restitution 0) to a bright teal (lively, restitution 1), so bounciness is visible.
+# Default plane colours: unbounded planes are a neutral floor; finite ones show their bounciness,
+# slate blue at restitution 0, green at 0.5, orange at 1 (the viewer's legend uses the same stops).
 GROUND_COLOR = (0.55, 0.57, 0.60)
-DEAD_PLANE_COLOR = np.array([0.33, 0.36, 0.44])
-LIVELY_PLANE_COLOR = np.array([0.38, 0.80, 0.74])
+RESTITUTION_STOPS = np.array([0.0, 0.5, 1.0])
+RESTITUTION_COLORS = np.array([[0.29, 0.36, 0.50], [0.30, 0.56, 0.42], [0.93, 0.55, 0.20]])
 
 
 class SceneError(ValueError):
@@ -90,8 +90,8 @@ class SceneInfo:
     name: str
     camera_position: np.ndarray  # (3,) m
     camera_look_at: np.ndarray  # (3,) m
-    sphere_colors: np.ndarray  # (N, 3) linear 0..1 floats, one row per ball in world order
-    plane_colors: np.ndarray  # (P, 3) 0..1 floats, one row per plane in world order
+    sphere_colors: np.ndarray  # (N, 3) sRGB 0..1 floats, one row per ball in world order
+    plane_colors: np.ndarray  # (P, 3) sRGB 0..1 floats, one row per plane in world order
     timestep: float  # s per physics step
     duration: float | None  # suggested run length in s, or None
 
@@ -498,7 +498,7 @@ BALL_KEYS = (
     "color",
 )
 SPHERE_KEYS = ("position", *BALL_KEYS)
-GRID_KEYS = ("corner", "center", "count", "spacing", "jitter", "seed", *BALL_KEYS)
+GRID_KEYS = ("corner", "center", "count", "spacing", "jitter", "velocity_jitter", "seed", *BALL_KEYS)
 TABLES = {"world": "table", "camera": "table", "plane": "array", "sphere": "array", "grid": "array"}
 
 
@@ -671,7 +671,9 @@ class _Builder:
                 color = np.array(GROUND_COLOR)
             else:
                 t = min(restitution, 1.0)
-                color = (1 - t) * DEAD_PLANE_COLOR + t * LIVELY_PLANE_COLOR
+                color = np.array(
+                    [np.interp(t, RESTITUTION_STOPS, RESTITUTION_COLORS[:, k]) for k in range(3)]
+                )
         return e, kwargs, color
 
     def ball_properties(self, e: _Entry) -> dict[str, object]:
@@ -697,8 +699,8 @@ class _Builder:
         balls.owners.append((balls.count, e, key, name))
         balls.positions.append(positions)
         for k in BALL_COLUMNS:
-            value = np.asarray(props[k], dtype=float)
-            balls.columns[k].append(np.broadcast_to(value, (n, *value.shape)))
+            per_ball = {"velocity": (3,), "angular_velocity": (3,), "orientation": (4,)}.get(k, ())
+            balls.columns[k].append(np.broadcast_to(np.asarray(props[k], dtype=float), (n, *per_ball)))
         balls.colors.append(colors)
 
     def sphere(self, e: _Entry, balls: _Balls) -> None:
@@ -738,6 +740,7 @@ class _Builder:
         spacing = e.extents("spacing", 3)
         spacing = np.full(3, 2.2 * radius) if spacing is None else spacing
         jitter = e.number("jitter", 0.0, nonnegative=True)
+        velocity_jitter = e.number("velocity_jitter", 0.0, nonnegative=True)
         seed = e.integer("seed", 0)
         need = 2 * radius + 2 * jitter
         for axis in range(3):
@@ -754,8 +757,13 @@ class _Builder:
         if center is not None:
             corner = center - 0.5 * (np.array(count) - 1) * spacing
         positions = corner + offsets
+        rng = np.random.default_rng(seed)  # seeded: the same file always gives the same balls
         if jitter > 0:
-            positions = positions + np.random.default_rng(seed).uniform(-jitter, jitter, size=positions.shape)
+            positions = positions + rng.uniform(-jitter, jitter, size=positions.shape)
+        if velocity_jitter > 0:
+            props["velocity"] = props["velocity"] + rng.uniform(
+                -velocity_jitter, velocity_jitter, size=(n, 3)
+            )
         colors = self.grid_colors(e, balls.count, n)
 
         def name(k: int) -> str:
