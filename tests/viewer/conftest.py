@@ -22,13 +22,19 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="session")
-def offscreen():
-    """A headless GL context with a 200×150 single-sample framebuffer and the real Renderer."""
+def offscreen_session():
     from ballpit.viewer.render import Offscreen
 
     screen = Offscreen((200, 150), samples=0)
     yield screen
     screen.close()
+
+
+@pytest.fixture
+def offscreen(offscreen_session):
+    """A headless GL context with a 200×150 single-sample framebuffer and the real Renderer, current."""
+    offscreen_session.window.switch_to()  # another test may have made its own context current
+    return offscreen_session
 
 
 def free_display() -> int:

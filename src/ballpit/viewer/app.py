@@ -71,6 +71,7 @@ class Viewer:
         self.held: set[str] = set()
         self.mouse_captured = False
         self.closed = False
+        self._window_closed = False
         self.screenshot_requested = False
         self.last_screenshot: Path | None = None
         self.physics_seconds = 0.0
@@ -160,8 +161,15 @@ class Viewer:
         self.window.set_exclusive_mouse(captured)
 
     def close(self) -> None:
-        if not self.closed:
-            self.closed = True
+        """Close the window. Outside pyglet's loop (``pump``) the close waits until the events being
+        dispatched are done, since pyglet's xlib dispatch cannot continue on a closed window."""
+        self.closed = True
+        if self._pyglet.app.event_loop.is_running:
+            self._close_window()
+
+    def _close_window(self) -> None:
+        if not self._window_closed:
+            self._window_closed = True
             self.window.close()
 
     # ------------------------------------------------------------------ pyglet events
@@ -286,11 +294,16 @@ class Viewer:
     def pump(self, dt: float | None = None) -> None:
         """One turn of the event loop by hand: deliver queued window events, draw a frame, flip.
         (pyglet queues events dispatched before its loop runs; this is what tests drive.)"""
+        if self.closed:
+            self._close_window()
+            return
         self.window.switch_to()
         self.window.dispatch_events()
-        if not self.closed:
-            self.frame(dt)
-            self.window.flip()
+        if self.closed:
+            self._close_window()
+            return
+        self.frame(dt)
+        self.window.flip()
 
     def run(self) -> None:
         """pyglet's event loop until the window closes."""

@@ -1,0 +1,160 @@
+"""Real windows under Xvfb: each scenario runs window_driver.py in its own process (a process is
+either a window process or a headless one, and this pytest process renders headless)."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from .conftest import REPO, subprocess_env
+from .window_driver import GOOD_SCENE
+
+DRIVER = Path(__file__).with_name("window_driver.py")
+
+
+def run_scenario(display: str, name: str, workdir: Path) -> dict:
+    proc = subprocess.run(
+        [sys.executable, str(DRIVER), name, str(workdir)],
+        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
+    assert lines, proc.stdout + proc.stderr
+    return json.loads(lines[-1][len("RESULT ") :])
+
+
+def test_the_title_shows_the_frame_rate(xvfb, tmp_path):
+    result = run_scenario(xvfb, "title", tmp_path)
+    assert result["first"] == "ballpit — untitled — 0.0 FPS"
+    match = re.fullmatch(r"ballpit — untitled — (\d+\.\d) FPS", result["caption"])
+    assert match and float(match.group(1)) > 1.0
+    assert result["frames"] > 5
+
+
+def test_nothing_moves_before_x_and_the_balls_fall_after_it(xvfb, tmp_path):
+    result = run_scenario(xvfb, "drop", tmp_path)
+    assert result["waited"] == result["start"] and result["time_waited"] == 0.0
+    assert result["phase"] == "RUNNING"
+    assert result["time_after"] == pytest.approx(0.5, abs=0.01)
+    fall = np.array(result["start"])[:, 1] - np.array(result["after"])[:, 1]
+    assert np.all(fall > 0.5)  # ½·g·t² ≈ 1.2 m in 0.5 s
+
+
+def test_wasd_qe_fly_the_camera_and_the_mouse_looks_and_scroll_sets_speed(xvfb, tmp_path):
+    result = run_scenario(xvfb, "fly", tmp_path)
+    distance = result["speed"] * 0.5  # 30 frames of 1/60 s
+    forward, right = np.array(result["forward"]), np.array(result["right"])
+    moves = {k: np.array(v) for k, v in result["moves"].items()}
+    assert np.allclose(moves["W"], forward * distance, atol=1e-6)
+    assert np.allclose(moves["S"], -forward * distance, atol=1e-6)
+    assert np.allclose(moves["A"], -right * distance, atol=1e-6)
+    assert np.allclose(moves["D"], right * distance, atol=1e-6)
+    assert np.allclose(moves["Q"], [0, -distance, 0], atol=1e-6)
+    assert np.allclose(moves["E"], [0, distance, 0], atol=1e-6)
+    assert np.linalg.norm(moves["LSHIFT+W"]) == pytest.approx(4 * distance)
+    assert result["yaw_change_right_drag"] > 0
+    assert result["scroll_speed_ratio"] == pytest.approx(1.25**2)
+
+
+def test_pause_single_step_and_reset_do_what_they_say(xvfb, tmp_path):
+    r = run_scenario(xvfb, "pause_step_reset", tmp_path)
+    assert r["paused_time"] > 0
+    assert r["still_time"] == r["paused_time"] and r["still_positions"] == r["paused_positions"]
+    assert r["after_n"] == pytest.approx(r["paused_time"] + r["dt"])
+    assert r["after_right"] == pytest.approx(r["paused_time"] + 2 * r["dt"])
+    assert r["resumed_time"] > r["after_right"] + 5 * r["dt"]
+    assert r["reset_positions"] == r["initial"] and r["reset_time"] == 0.0
+    assert r["reset_phase"] == "WAITING" and "press X" in r["hud"]
+
+
+def test_a_broken_scene_reload_keeps_the_app_running_and_shows_the_error(xvfb, tmp_path):
+    r = run_scenario(xvfb, "broken_reload", tmp_path)
+    assert r["title"].startswith("ballpit — live.toml — ")
+    assert "live.toml" in r["f5_error"] and "radius" in r["f5_error"]
+    assert r["f5_same_world"] and r["still_running"]
+    assert r["error_pixels"] > 30  # the error is drawn in the window
+    assert "syntax" in r["auto_error"].lower()  # noticed on save, without a key press
+    assert r["auto_same_world"]
+    assert r["ctrl_r_error"] == r["auto_error"]
+    assert r["fixed_error"] == "" and r["fixed_balls"] == 2 and r["fixed_phase"] == "WAITING"
+    assert r["alive"]
+
+
+def test_integrator_time_scale_overlay_hud_help_screenshot_and_escape_keys(xvfb, tmp_path):
+    r = run_scenario(xvfb, "keys", tmp_path)
+    assert [r["integrator_1"], r["integrator_2"], r["integrator_3"]] == ["euler", "rk2", "rk4"]
+    assert r["faster"] == 2.0 and r["slower"] == 0.5
+    assert r["overlays"] == [True, True, True]
+    assert r["draw_labels"] == ["planes", "balls", "world lines", "overlay lines"]
+    assert r["hud_hidden"] and r["help_shown"]
+    shot = Path(r["screenshot"])
+    assert shot.parent == tmp_path and shot.suffix == ".png" and shot.stat().st_size > 1000
+    assert r["captured"]
+    assert r["after_first_escape"] == {"captured": False, "closed": False}
+    assert r["after_second_escape"] == {"closed": True}
+
+
+# ---------------------------------------------------------------------- the real event loop + X input
+def xdotool(display: str, *args: str) -> str:
+    out = subprocess.run(
+        ["xdotool", *args], env=subprocess_env(display), capture_output=True, text=True, timeout=20
+    )
+    return out.stdout.strip()
+
+
+@pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
+def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escape(xvfb, tmp_path):
+    scene = tmp_path / "demo.toml"
+    scene.write_text(GOOD_SCENE)
+    code = "import sys, pathlib; from ballpit.viewer.app import run; sys.exit(run(pathlib.Path(sys.argv[1])))"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, str(scene)], env=subprocess_env(xvfb), cwd=tmp_path,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        window = ""
+        deadline = time.monotonic() + 30
+        while not window and time.monotonic() < deadline:
+            window = xdotool(xvfb, "search", "--name", "demo.toml").split("\n")[0]
+            time.sleep(0.1)
+        assert window, "the viewer window never appeared"
+        time.sleep(1.0)  # let the FPS title update
+        name = xdotool(xvfb, "getwindowname", window)
+        match = re.fullmatch(r"ballpit — demo\.toml — (\d+\.\d) FPS", name)
+        assert match and float(match.group(1)) > 0, name
+        xdotool(xvfb, "mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
+        for keys in (["x"], ["F12"], ["Escape"]):
+            xdotool(xvfb, "key", "--delay", "50", *keys)
+            time.sleep(0.3)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err, err
+    shot = re.search(r"screenshot saved to (\S+\.png)", out)
+    assert shot and Path(shot.group(1)).is_file(), out
+
+
+def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
+    code = "import sys; from ballpit.viewer.app import run; sys.exit(run())"
+    for display in (None, ":12345"):  # no DISPLAY at all; a DISPLAY with no server behind it
+        proc = subprocess.run(
+            [sys.executable, "-c", code], env=subprocess_env(display), cwd=REPO,
+            capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert proc.returncode == 1, proc.stderr
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1, proc.stderr
+        assert "no display" in lines[0] and "ballpit render SCENE --out demo.gif" in lines[0]
+        assert "xvfb-run ballpit" in lines[0]

@@ -1,0 +1,255 @@
+"""Drives a real viewer window (pyglet + GLX under Xvfb) through one scenario and prints what it saw.
+
+Run as ``python window_driver.py SCENARIO WORKDIR`` with DISPLAY set (test_window.py does this). Input
+goes in as real pyglet events dispatched into the real window and delivered by pyglet's event queue;
+the window, GL context, shaders and physics are all real. The last stdout line is ``RESULT <json>``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import ballpit
+from ballpit.viewer.app import Viewer
+
+FRAME = 1.0 / 60.0
+
+GOOD_SCENE = """
+[camera]
+position = [0, 3, 10]
+look_at = [0, 1, 0]
+
+[[plane]]
+position = [0, 0, 0]
+
+[[sphere]]
+position = [0, 3, 0]
+radius = 0.3
+color = "#e0482f"
+"""
+
+
+OPENED: list[Viewer] = []
+
+
+def open_viewer(**kwargs: object) -> Viewer:
+    viewer = Viewer(size=(320, 180), **kwargs)
+    OPENED.append(viewer)
+    return viewer
+
+
+def balls_world() -> ballpit.World:
+    world = ballpit.World()
+    world.add_plane(position=(0, 0, 0))
+    world.add_plane(position=(0, 2, 0), rotation=(0, 0, 20), size=4.0, restitution=0.6)
+    world.add_spheres([[-2, 6, 0], [-1, 6, 0], [0, 6, 0], [1, 6, 0], [2, 6, 0]], radius=0.3)
+    return world
+
+
+def press(viewer: Viewer, name: str, modifiers: int = 0, frames: int = 1) -> None:
+    """Press and release a key (by pyglet name) through the window's event queue."""
+    from pyglet.window import key
+
+    symbol = getattr(key, name)
+    viewer.window.dispatch_event("on_key_press", symbol, modifiers)
+    viewer.window.dispatch_event("on_key_release", symbol, modifiers)
+    pump(viewer, frames)
+
+
+def hold(viewer: Viewer, names: list[str], frames: int) -> None:
+    """Hold keys down for ``frames`` frames of 1/60 s, then release them."""
+    from pyglet.window import key
+
+    for name in names:
+        viewer.window.dispatch_event("on_key_press", getattr(key, name), 0)
+    pump(viewer, frames)
+    for name in names:
+        viewer.window.dispatch_event("on_key_release", getattr(key, name), 0)
+    pump(viewer, 1, dt=0.0)
+
+
+def pump(viewer: Viewer, frames: int, dt: float | None = FRAME) -> None:
+    for _ in range(frames):
+        viewer.pump(dt)
+
+
+def pump_for(viewer: Viewer, seconds: float) -> None:
+    """Run in real time (wall-clock frame times) for a while."""
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end and not viewer.closed:
+        viewer.pump()
+
+
+def positions(viewer: Viewer) -> list:
+    return np.asarray(viewer.sim.world.spheres.positions).tolist()
+
+
+# ---------------------------------------------------------------------- scenarios
+def title(workdir: Path) -> dict:
+    viewer = open_viewer(world=balls_world())
+    first = viewer.window.caption
+    pump_for(viewer, 1.2)
+    return {"first": first, "caption": viewer.window.caption, "fps": viewer.fps, "frames": viewer.frames}
+
+
+def drop(workdir: Path) -> dict:
+    viewer = open_viewer(world=balls_world())
+    start = positions(viewer)
+    pump(viewer, 30)
+    waited = positions(viewer)
+    time_waited = viewer.sim.world.time
+    press(viewer, "X", frames=30)
+    return {"start": start, "waited": waited, "time_waited": time_waited, "after": positions(viewer),
+            "time_after": viewer.sim.world.time, "phase": viewer.sim.phase.name}  # fmt: skip
+
+
+def fly(workdir: Path) -> dict:
+    viewer = open_viewer(world=balls_world())
+    cam = viewer.camera
+    out = {"speed": cam.speed, "forward": cam.forward.tolist(), "right": cam.right.tolist(), "moves": {}}
+    for keys in (["W"], ["S"], ["A"], ["D"], ["Q"], ["E"], ["LSHIFT", "W"]):
+        before = cam.position.copy()
+        hold(viewer, keys, 30)  # 0.5 s
+        out["moves"]["+".join(keys)] = (cam.position - before).tolist()
+    before = cam.yaw
+    from pyglet.window import mouse
+
+    viewer.window.dispatch_event("on_mouse_drag", 100, 100, 40, 0, mouse.RIGHT, 0)
+    pump(viewer, 1)
+    out["yaw_change_right_drag"] = cam.yaw - before
+    speed = cam.speed
+    viewer.window.dispatch_event("on_mouse_scroll", 100, 100, 0, 2)
+    pump(viewer, 1)
+    out["scroll_speed_ratio"] = cam.speed / speed
+    return out
+
+
+def pause_step_reset(workdir: Path) -> dict:
+    viewer = open_viewer(world=balls_world())
+    sim = viewer.sim
+    initial = positions(viewer)
+    press(viewer, "X", frames=10)
+    press(viewer, "SPACE")
+    paused_time, paused_positions = sim.world.time, positions(viewer)
+    pump(viewer, 20)
+    still_time, still_positions = sim.world.time, positions(viewer)
+    press(viewer, "N")
+    after_n = sim.world.time
+    press(viewer, "RIGHT")
+    after_right = sim.world.time
+    press(viewer, "SPACE", frames=10)
+    resumed_time = sim.world.time
+    press(viewer, "R", frames=5)
+    return {
+        "dt": sim.timestep, "initial": initial, "paused_time": paused_time,
+        "paused_positions": paused_positions, "still_time": still_time, "still_positions": still_positions,
+        "after_n": after_n,
+        "after_right": after_right, "resumed_time": resumed_time, "reset_positions": positions(viewer),
+        "reset_time": sim.world.time, "reset_phase": sim.phase.name, "hud": viewer.hud.text,
+    }  # fmt: skip
+
+
+def touch_later(path: Path, text: str) -> None:
+    """Rewrite the file and make sure its modification time changes visibly."""
+    path.write_text(text)
+    stat = path.stat()
+    import os
+
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + 2_000_000_000))
+
+
+def broken_reload(workdir: Path) -> dict:
+    from pyglet.window import key
+
+    from ballpit.viewer.hud import ERROR_COLOR
+
+    scene = workdir / "live.toml"
+    scene.write_text(GOOD_SCENE)
+    viewer = open_viewer(scene_path=scene)
+    sim = viewer.sim
+    press(viewer, "X", frames=10)
+    world = sim.world
+    out: dict = {"title": viewer.window.caption}
+
+    touch_later(scene, GOOD_SCENE.replace("radius = 0.3", "radius = -0.3"))
+    press(viewer, "F5", frames=5)
+    out["f5_error"] = viewer.hud.error
+    out["f5_same_world"] = sim.world is world
+    t = sim.world.time
+    pump(viewer, 10)
+    out["still_running"] = sim.world.time > t and not viewer.closed
+
+    press(viewer, "F12", frames=1)  # the error is on screen: look for its colour in the screenshot
+    from PIL import Image
+
+    shot = np.asarray(Image.open(viewer.last_screenshot).convert("RGB")).astype(int)
+    out["error_pixels"] = int((np.abs(shot - np.array(ERROR_COLOR[:3])).max(axis=-1) < 40).sum())
+
+    touch_later(scene, "[[sphere]\nposition = [0, 3, 0]\n")  # a TOML syntax error, saved
+    pump_for(viewer, 0.8)  # the file watcher notices within 0.5 s
+    out["auto_error"] = viewer.hud.error
+    out["auto_same_world"] = sim.world is world
+
+    press(viewer, "R", modifiers=key.MOD_CTRL, frames=2)
+    out["ctrl_r_error"] = viewer.hud.error
+
+    touch_later(scene, GOOD_SCENE + "\n[[sphere]]\nposition = [1, 3, 0]\nradius = 0.2\n")
+    pump_for(viewer, 0.8)
+    out["fixed_error"] = viewer.hud.error
+    out["fixed_balls"] = sim.ball_count
+    out["fixed_phase"] = sim.phase.name
+    out["alive"] = not viewer.closed
+    return out
+
+
+def keys(workdir: Path) -> dict:
+    viewer = open_viewer(world=balls_world())
+    sim = viewer.sim
+    out: dict = {}
+    for name in ("_1", "_2", "_3"):
+        press(viewer, name)
+        out[f"integrator{name}"] = sim.world.integrator
+    press(viewer, "EQUAL")
+    out["faster"] = sim.time_scale
+    press(viewer, "MINUS")
+    press(viewer, "MINUS")
+    out["slower"] = sim.time_scale
+    press(viewer, "X", frames=20)
+    for name in ("C", "V", "T"):
+        press(viewer, name, frames=2)
+    out["overlays"] = [viewer.flags.contacts, viewer.flags.velocities, viewer.flags.trails]
+    out["draw_labels"] = [c.label for c in viewer.renderer.draws.calls]
+    press(viewer, "H")
+    out["hud_hidden"] = not viewer.hud.show_hud
+    press(viewer, "F1")
+    out["help_shown"] = viewer.hud.show_help
+    press(viewer, "F12")
+    out["screenshot"] = str(viewer.last_screenshot)
+    press(viewer, "TAB")
+    out["captured"] = viewer.mouse_captured
+    press(viewer, "ESCAPE")
+    out["after_first_escape"] = {"captured": viewer.mouse_captured, "closed": viewer.closed}
+    press(viewer, "ESCAPE")
+    out["after_second_escape"] = {"closed": viewer.closed}
+    return out
+
+
+SCENARIOS = {f.__name__: f for f in (title, drop, fly, pause_step_reset, broken_reload, keys)}
+
+
+def main() -> None:
+    scenario, workdir = sys.argv[1], Path(sys.argv[2])
+    result = SCENARIOS[scenario](workdir)
+    for viewer in OPENED:
+        viewer.close()
+        viewer.pump()  # outside pyglet's loop the window closes on the next pump
+    print("RESULT " + json.dumps(result), flush=True)
+
+
+if __name__ == "__main__":
+    main()
