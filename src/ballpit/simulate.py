@@ -69,7 +69,7 @@ def energy(world: World, inertia: np.ndarray | None = None) -> Energy:
     kinetic = 0.5 * float(m @ np.einsum("ij,ij->i", v, v)) + 0.5 * float(
         inertia @ np.einsum("ij,ij->i", w, w)
     )
-    potential = -float(m @ (balls.positions @ world.gravity))
+    potential = 0.0 - float(m @ (balls.positions @ world.gravity))  # 0.0 -: no '-0' without gravity
     return Energy(kinetic, potential)
 
 
