@@ -83,7 +83,7 @@ def test_a_broken_scene_reload_keeps_the_app_running_and_shows_the_error(xvfb, t
     assert r["f5_same_world"] and r["still_running"]
     assert r["error_pixels"] > 30  # the error is drawn in the window
     assert "syntax" in r["auto_error"].lower()  # noticed on save, without a key press
-    assert r["auto_same_world"]
+    assert r["auto_same_world"] and r["auto_seconds"] < 5
     assert r["ctrl_r_error"] == r["auto_error"]
     assert r["fixed_error"] == "" and r["fixed_balls"] == 2 and r["fixed_phase"] == "WAITING"
     assert r["alive"]
@@ -122,20 +122,27 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escap
     )  # fmt: skip
     try:
         window = ""
-        deadline = time.monotonic() + 30
-        while not window and time.monotonic() < deadline:
+        deadline = time.monotonic() + 60
+        while not window and time.monotonic() < deadline and proc.poll() is None:
             window = xdotool(xvfb, "search", "--name", "demo.toml").split("\n")[0]
             time.sleep(0.1)
-        assert window, "the viewer window never appeared"
-        time.sleep(1.0)  # let the FPS title update
-        name = xdotool(xvfb, "getwindowname", window)
-        match = re.fullmatch(r"ballpit — demo\.toml — (\d+\.\d) FPS", name)
-        assert match and float(match.group(1)) > 0, name
+        assert window, f"the viewer window never appeared (exit status {proc.poll()})"
+        name = ""
+        deadline = time.monotonic() + 30
+        while not re.search(r"[1-9]\d*\.\d FPS$", name) and time.monotonic() < deadline:
+            time.sleep(0.2)  # the title's FPS updates twice a second once frames flow
+            name = xdotool(xvfb, "getwindowname", window)
+        assert re.fullmatch(r"ballpit — demo\.toml — \d+\.\d FPS", name), name
         xdotool(xvfb, "mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
         for keys in (["x"], ["F12"], ["Escape"]):
             xdotool(xvfb, "key", "--delay", "50", *keys)
             time.sleep(0.3)
-        out, err = proc.communicate(timeout=20)
+        try:
+            out, err = proc.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, err = proc.communicate()
+            pytest.fail(f"the viewer did not quit on Escape; title {name!r}; stdout {out!r}; stderr {err!r}")
     finally:
         if proc.poll() is None:
             proc.kill()
