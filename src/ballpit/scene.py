@@ -106,7 +106,7 @@ def load_scene(path: str | Path) -> World:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise _syntax_error(path, e) from None
+        raise _syntax_error(path, text, e) from None
     return _Builder(path, text, data).build()
 
 
@@ -172,7 +172,7 @@ _AT_LINE = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
 _AT_END = re.compile(r"\s*\(at end of document\)\s*$")
 
 
-def _syntax_error(path: Path, e: tomllib.TOMLDecodeError) -> SceneError:
+def _syntax_error(path: Path, text: str, e: tomllib.TOMLDecodeError) -> SceneError:
     msg = str(e)
     m = _AT_LINE.search(msg)
     if m:
@@ -180,7 +180,10 @@ def _syntax_error(path: Path, e: tomllib.TOMLDecodeError) -> SceneError:
         return SceneError(path, problem, line=int(m.group(1)))
     m = _AT_END.search(msg)
     if m:
-        return SceneError(path, f"TOML syntax error: {msg[: m.start()]} (at the end of the file)")
+        # Something left open (an array, a string): point at the last line that has anything on it.
+        lines = text.splitlines()
+        last = max((i + 1 for i, ln in enumerate(lines) if ln.strip()), default=None)
+        return SceneError(path, f"TOML syntax error: {msg[: m.start()]} at the end of the file", line=last)
     return SceneError(path, f"TOML syntax error: {msg}")
 
 

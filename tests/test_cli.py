@@ -1,0 +1,321 @@
+"""The real command line in a subprocess: exit codes, one-line errors, output files and their columns."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+TRAJECTORY_HEADER = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw"
+EVENTS_HEADER = "time,kind,a,b,x,y,z,nx,ny,nz,impulse"
+
+
+def ballpit(*args: str | Path, cwd: Path = ROOT, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "ballpit", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=timeout,
+    )
+
+
+def assert_user_error(r: subprocess.CompletedProcess, *expected: str) -> str:
+    """Exit status 2, no traceback, one line on stderr containing every expected fragment."""
+    assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    for fragment in expected:
+        assert fragment in lines[0], (fragment, lines[0])
+    return lines[0]
+
+
+BALL = "[[sphere]]\nposition = [0, 1, 0]\n"
+
+# (name, scene text, fragments the one-line message must contain). Line numbers are the line of the
+# offending key (or the entry's header when no key is at fault).
+BAD_SCENES = [
+    ("syntax error", "[world]\ngravity = [0, -9.81, 0\n", [":2:", "TOML syntax error", "Unclosed array"]),
+    (
+        "syntax error, bad value",
+        "[[sphere]]\nposition = [0, 1, 0]\nradius = ?\n",
+        [":3:", "TOML syntax error"],
+    ),
+    (
+        "unknown key",
+        BALL + "radus = 0.3\n",
+        [":3:", "sphere #1", "unknown key 'radus'", "did you mean 'radius'?"],
+    ),
+    ("unknown table", "[[spheres]]\nposition = [0, 1, 0]\n", [":1:", "'spheres'", "did you mean 'sphere'?"]),
+    ("unknown world key", "[world]\ngravty = [0, -1, 0]\n", [":2:", "[world]", "did you mean 'gravity'?"]),
+    ("top-level key", "gravity = [0, -1, 0]\n", [":1:", "'gravity'", "[world]"]),
+    ("single-bracket sphere", "[sphere]\nposition = [0, 1, 0]\n", [":1:", "[[sphere]]"]),
+    (
+        "wrong type",
+        BALL + 'radius = "big"\n',
+        [":3:", "sphere #1", "key 'radius'", "must be a number", '"big"'],
+    ),
+    ("wrong type, bool", BALL + "mass = true\n", [":3:", "key 'mass'", "got true"]),
+    ("wrong type, hollow", BALL + "hollow = 1\n", [":3:", "key 'hollow'", "true or false"]),
+    ("vector length", "[[sphere]]\nposition = [0, 1]\n", [":2:", "key 'position'", "3 components", "[0, 1]"]),
+    (
+        "vector of strings",
+        '[[sphere]]\nposition = ["0", 1, 2]\n',
+        [":2:", "key 'position'", "list of 3 numbers"],
+    ),
+    ("not finite, nan", "[[sphere]]\nposition = [0, nan, 0]\n", [":2:", "must be finite", "[0, nan, 0]"]),
+    (
+        "not finite, inf",
+        BALL + "velocity = [inf, 0, 0]\n",
+        [":3:", "key 'velocity'", "must be finite", "inf"],
+    ),
+    ("not finite, radius", BALL + "radius = -inf\n", [":3:", "key 'radius'", "-inf"]),
+    (
+        "radius not positive",
+        BALL + "radius = -1.0\n",
+        [":3:", "sphere #1", "key 'radius'", "must be positive", "-1.0"],
+    ),
+    ("mass not positive", "\n" + BALL + "mass = 0\n", [":4:", "key 'mass'", "must be positive, got 0"]),
+    ("zero normal", "[[plane]]\nnormal = [0, 0, 0]\n", [":2:", "plane #1", "key 'normal'", "zero vector"]),
+    (
+        "normal and rotation",
+        "[[plane]]\nnormal = [0, 1, 0]\nrotation = [0, 0, 10]\n",
+        [":3:", "plane #1", "key 'rotation'", "not both"],
+    ),
+    (
+        "unknown integrator",
+        '[world]\nintegrator = "rk5"\n',
+        [":2:", "[world]", "key 'integrator'", "euler, rk2, rk4", '"rk5"'],
+    ),
+    (
+        "overlapping balls",
+        BALL + "radius = 0.5\n\n[[sphere]]\nposition = [0.5, 1, 0]\nradius = 0.5\n",
+        [":6:", "sphere #2", "key 'position'", "overlaps sphere #1"],
+    ),
+    (
+        "negative restitution",
+        "[[plane]]\nsize = 4\nrestitution = -0.5\n",
+        [":3:", "plane #1", "key 'restitution'", "must not be negative", "-0.5"],
+    ),
+    ("negative friction", BALL + "friction = -0.1\n", [":3:", "sphere #1", "key 'friction'", "-0.1"]),
+    ("negative drag", "[world]\nlinear_drag = -1\n", [":2:", "[world]", "key 'linear_drag'"]),
+    ("bad size", "[[plane]]\nsize = [1, 2, 3]\n", [":2:", "key 'size'", "[1, 2, 3]"]),
+    ("bad colour", BALL + 'color = "red"\n', [":3:", "key 'color'", "#rrggbb"]),
+    ("colour out of range", BALL + "color = [255, 0, 0]\n", [":3:", "key 'color'", "between 0 and 1"]),
+    ("missing position", "[[sphere]]\nradius = 1\n", [":1:", "sphere #1", "missing required key 'position'"]),
+    ("grid count", "[[grid]]\ncorner = [0, 1, 0]\ncount = [2, 0, 1]\n", [":3:", "grid #1", "key 'count'"]),
+    ("grid without place", "[[grid]]\ncount = [2, 2, 2]\n", [":1:", "grid #1", "'corner'"]),
+    ("camera on its target", "[camera]\nposition = [1, 1, 1]\nlook_at = [1, 1, 1]\n", [":3:", "[camera]"]),
+]
+
+
+@pytest.mark.parametrize(("text", "expected"), [c[1:] for c in BAD_SCENES], ids=[c[0] for c in BAD_SCENES])
+def test_bad_scene_exits_2_with_one_line_naming_file_entry_key_value_and_line(tmp_path, text, expected):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text)
+    r = ballpit("check", scene)
+    line = assert_user_error(r, str(scene), *expected)
+    assert line.startswith(f"ballpit: {scene}:")
+    assert r.stdout == ""
+
+
+def test_missing_file(tmp_path):
+    assert_user_error(ballpit("check", tmp_path / "nope.toml"), "nope.toml", "no such file")
+    assert_user_error(ballpit("simulate", tmp_path / "nope.toml"), "nope.toml", "no such file")
+
+
+def test_directory_and_binary_files(tmp_path):
+    (tmp_path / "d.toml").mkdir()
+    assert_user_error(ballpit("check", tmp_path / "d.toml"), "d.toml", "directory")
+    binary = tmp_path / "b.toml"
+    binary.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")
+    assert_user_error(ballpit("check", binary), "b.toml", "UTF-8")
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["simulate", "scenes/slopes.toml", "--duration", "-1"], "--duration"),
+        (["simulate", "scenes/slopes.toml", "--duration", "abc"], "--duration"),
+        (["simulate", "scenes/slopes.toml", "--dt", "0"], "--dt"),
+        (["simulate", "scenes/slopes.toml", "--every", "0"], "--every"),
+        (["simulate", "scenes/slopes.toml", "--integrator", "rk5"], "--integrator"),
+        (["simulate", "scenes/slopes.toml", "--frobnicate"], "--frobnicate"),
+        (["simulate"], "scene"),
+        (["render", "scenes/slopes.toml", "--out", "x.gif", "--size", "big"], "--size"),
+        (["nonsense"], "nonsense"),
+    ],
+)
+def test_bad_options_exit_2_in_one_line(args, fragment):
+    assert_user_error(ballpit(*args), fragment)
+
+
+def test_bad_output_paths_exit_2_and_leave_nothing(tmp_path):
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.05", "--out", tmp_path / "t.txt")
+    assert_user_error(r, "t.txt", ".csv or .npz")
+    good = tmp_path / "t.csv"
+    r = ballpit(
+        "simulate",
+        "scenes/slopes.toml",
+        "--duration",
+        "0.05",
+        "--out",
+        good,
+        "--events",
+        tmp_path / "no" / "e.csv",
+    )
+    assert_user_error(r, "e.csv", "does not exist")
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.05", "--out", good, "--events", good)
+    assert_user_error(r, "different files")
+    assert list(tmp_path.iterdir()) == [], "no output, not even a temporary file, may be left behind"
+
+
+def test_check_reports_ok():
+    r = ballpit("check", "scenes/slopes.toml")
+    assert r.returncode == 0 and r.stderr == ""
+    assert "slopes.toml: ok: 5 balls, 5 planes" in r.stdout
+
+
+def test_bundled_scene_by_name_from_anywhere(tmp_path):
+    r = ballpit("check", "cradle", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "cradle.toml: ok" in r.stdout
+
+
+def test_simulate_writes_csv_with_exact_columns_and_a_summary(tmp_path):
+    out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
+    r = ballpit(
+        "simulate", "scenes/slopes.toml", "--duration", "0.7", "--every", "4", "--out", out, "--events", ev
+    )
+    assert r.returncode == 0, r.stderr
+    for fragment in ("168 steps", "steps/s", "wall time", "contacts", "energy start", "kinetic", "potential"):
+        assert fragment in r.stdout
+    assert "Traceback" not in r.stderr
+
+    lines = out.read_text().splitlines()
+    assert lines[0] == TRAJECTORY_HEADER
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert data.shape == (5 * (168 // 4 + 1), 15)
+    assert np.array_equal(data[:, 1], np.tile(np.arange(5), 168 // 4 + 1))
+    times = data[::5, 0]
+    assert (
+        times[0] == 0.0
+        and np.allclose(np.diff(times), 4 / 240, atol=1e-6)
+        and times[-1] == pytest.approx(0.7)
+    )
+    assert np.allclose(data[:5, 2:5], [[-8.75, 5.5, -0.177], [-2.5, 4.749, 0.177], [3, 4.5, -0.177],
+                                       [7.5, 4.399, 0.177], [-8.9, 10.5, 0]])  # fmt: skip
+    assert np.allclose(np.linalg.norm(data[:, 11:15], axis=1), 1.0)
+
+    ev_lines = ev.read_text().splitlines()
+    assert ev_lines[0] == EVENTS_HEADER
+    rows = [line.split(",") for line in ev_lines[1:]]
+    assert rows and all(len(row) == 11 for row in rows)
+    assert {row[1] for row in rows} <= {"sphere-plane", "sphere-sphere"}
+    assert {int(row[3]) for row in rows if row[1] == "sphere-plane"} >= {1, 2, 3, 4}, (
+        "by 0.7 s every slope is hit"
+    )
+    assert all(0 < float(row[0]) <= 0.7 + 1e-9 and float(row[10]) >= 0 for row in rows)
+    assert sorted(tmp_path.iterdir()) == sorted([ev, out]), "no temporary files left"
+
+
+def test_npz_holds_the_same_data_as_csv(tmp_path):
+    args = ["simulate", "scenes/slopes.toml", "--duration", "0.7", "--every", "3"]
+    assert ballpit(*args, "--out", tmp_path / "t.csv", "--events", tmp_path / "e.csv").returncode == 0
+    assert ballpit(*args, "--out", tmp_path / "t.npz", "--events", tmp_path / "e.npz").returncode == 0
+    csv = np.loadtxt(tmp_path / "t.csv", delimiter=",", skiprows=1)
+    with np.load(tmp_path / "t.npz") as npz:
+        assert list(npz.keys()) == TRAJECTORY_HEADER.split(",")
+        assert npz["id"].dtype.kind == "i"
+        stacked = np.column_stack([npz[k] for k in TRAJECTORY_HEADER.split(",")])
+    assert np.allclose(stacked, csv, rtol=1e-8, atol=1e-9)
+    ev_csv = np.genfromtxt(tmp_path / "e.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    with np.load(tmp_path / "e.npz") as npz:
+        assert list(npz.keys()) == EVENTS_HEADER.split(",")
+        assert list(npz["kind"]) == list(ev_csv["kind"])
+        for key in ("time", "a", "b", "x", "y", "z", "nx", "ny", "nz", "impulse"):
+            assert np.allclose(npz[key], ev_csv[key], rtol=1e-8, atol=1e-9), key
+
+
+def test_overrides_and_quiet(tmp_path):
+    out = tmp_path / "t.csv"
+    overrides = ["--duration", "0.1", "--dt", "0.01", "--integrator", "euler"]
+    r = ballpit("simulate", "scenes/slopes.toml", *overrides, "--out", out, "-q")
+    assert r.returncode == 0 and r.stdout == "" and r.stderr == ""
+    times = np.loadtxt(out, delimiter=",", skiprows=1)[::5, 0]
+    assert np.allclose(times, np.arange(11) * 0.01)
+
+
+def test_duration_that_is_not_a_whole_number_of_steps_ends_exactly(tmp_path):
+    out = tmp_path / "t.csv"
+    assert (
+        ballpit(
+            "simulate", "scenes/cradle.toml", "--duration", "0.105", "--dt", "0.01", "--out", out
+        ).returncode
+        == 0
+    )
+    times = np.loadtxt(out, delimiter=",", skiprows=1)[::6, 0]
+    assert times[-1] == pytest.approx(0.105) and len(times) == 12
+
+
+def test_interrupt_leaves_no_partial_file(tmp_path):
+    out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "ballpit",
+            "simulate",
+            "scenes/pile10k.toml",
+            "--duration",
+            "60",
+            "--out",
+            out,
+            "--events",
+            ev,
+        ],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 60
+    while not any(p.name.endswith(".partial") for p in tmp_path.iterdir()) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)  # now inside the stepping loop
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_failed_writer_leaves_target_untouched(tmp_path):
+    out = tmp_path / "t.csv"
+    out.write_text("previous complete run\n")
+    r = ballpit(
+        "simulate", "scenes/slopes.toml", "--duration", "0.05", "--out", out, "--events", tmp_path / "e.bin"
+    )
+    assert_user_error(r, "e.bin")
+    assert out.read_text() == "previous complete run\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+
+
+def test_help_and_version():
+    r = ballpit("--help")
+    assert r.returncode == 0 and "simulate" in r.stdout and "check" in r.stdout
+    r = ballpit("--version")
+    assert r.returncode == 0 and r.stdout.startswith("ballpit ")
+
+
+def test_python_m_and_console_script_agree():
+    script = Path(sys.executable).parent / "ballpit"
+    r = subprocess.run([str(script), "check", "scenes/slopes.toml"], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0 and "ok" in r.stdout

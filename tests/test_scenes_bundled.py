@@ -1,0 +1,235 @@
+"""The bundled scenes: each one checks and simulates, and the demos do what their comments promise.
+
+The slopes demo is judged only from what the real command line writes (trajectory and events CSV),
+the way a user would check it.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ballpit.scene import bundled_scenes, load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "scenes"
+REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k"}
+# Enough simulated time to exercise each scene while keeping the suite fast (big piles: a few steps).
+SHORT_RUN = {"pile": 3, "pile10k": 2, "gas": 3, "billiards": 20}  # steps
+DEFAULT_STEPS = 24
+
+
+def ballpit(*args: str | Path, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "ballpit", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=timeout,
+    )
+
+
+def simulate_csv(tmp_path: Path, scene: str, *args: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run ``ballpit simulate`` and read back (trajectory rows, event rows, event kinds)."""
+    out, ev = tmp_path / f"{scene}.csv", tmp_path / f"{scene}-events.csv"
+    r = ballpit("simulate", SCENES / f"{scene}.toml", "--out", out, "--events", ev, *args)
+    assert r.returncode == 0, r.stderr
+    traj = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    kinds = np.loadtxt(ev, delimiter=",", skiprows=1, usecols=1, dtype=str, ndmin=1)
+    events = np.loadtxt(ev, delimiter=",", skiprows=1, usecols=[0, 2, 3, 4, 5, 6, 7, 8, 9, 10], ndmin=2)
+    return traj, events, kinds
+
+
+def test_the_required_scenes_are_bundled():
+    names = {p.stem for p in bundled_scenes()}
+    assert names >= REQUIRED, REQUIRED - names
+    assert (SCENES / "slopes.toml") in bundled_scenes() or any(
+        p.name == "slopes.toml" for p in bundled_scenes()
+    )
+
+
+@pytest.mark.parametrize("path", sorted(SCENES.glob("*.toml")), ids=lambda p: p.stem)
+def test_every_bundled_scene_checks_and_simulates(tmp_path, path):
+    r = ballpit("check", path)
+    assert r.returncode == 0 and ": ok:" in r.stdout, r.stderr
+    world = load_scene(path)
+    steps = SHORT_RUN.get(path.stem, DEFAULT_STEPS)
+    dt = world.scene.timestep
+    out = tmp_path / "t.csv"
+    r = ballpit("simulate", path, "--duration", repr(steps * dt), "--out", out)
+    assert r.returncode == 0, r.stderr
+    assert f"{steps} steps" in r.stdout
+    rows = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    assert rows.shape == ((steps + 1) * len(world.spheres), 15)
+    assert np.isfinite(rows).all()
+    first = path.read_text().splitlines()[0]
+    assert first.startswith("# "), "each scene opens with a one-line description"
+
+
+@pytest.mark.parametrize(("name", "at_least"), [("pile", 1000), ("pile10k", 10_000)])
+def test_piles_pour_into_a_box(name, at_least):
+    world = load_scene(SCENES / f"{name}.toml")
+    assert len(world.spheres) >= at_least
+    planes = list(world.planes)
+    assert len(planes) == 5 and all(not p.infinite for p in planes)
+    floor, walls = planes[0], planes[1:]
+    assert np.allclose(floor.normal, [0, 1, 0])
+    assert all(abs(w.normal[1]) < 1e-12 for w in walls)
+    # every ball starts above the floor and inside the walls' footprint
+    pos = world.spheres.positions
+    half = floor.size[0] / 2
+    assert (np.abs(pos[:, [0, 2]]) < half).all() and (pos[:, 1] > 0).all()
+
+
+def test_incline_balls_accelerate_as_the_textbook_says(tmp_path):
+    traj, _, _ = simulate_csv(tmp_path, "incline", "--duration", "1.0")
+    vx = traj[-4:, 5]  # the four balls at t = 1 s
+    speed_along_slope = -vx / math.cos(math.radians(30))
+    g = 9.81
+    s, c = math.sin(math.radians(30)), math.cos(math.radians(30))
+    expected = [g * s, g * (s - 0.1 * c), 5 / 7 * g * s, 3 / 5 * g * s]
+    assert np.allclose(speed_along_slope, expected, rtol=0.01)
+
+
+def test_cradle_passes_momentum_down_the_line(tmp_path):
+    traj, _, kinds = simulate_csv(tmp_path, "cradle", "--duration", "0.5")
+    last = traj[-6:]
+    assert np.allclose(last[:5, 5], 0, atol=0.02), "the striker and the middle balls stop"
+    assert last[5, 5] == pytest.approx(2.0, rel=0.01), "the far ball leaves at the striker's speed"
+    assert (kinds == "sphere-sphere").sum() >= 5
+
+
+# --------------------------------------------------------------------------- the slopes demo
+
+GROUND, SLOPES = 0, {1, 2, 3, 4}
+RADIUS = 0.25
+
+
+def project(points: np.ndarray, camera: np.ndarray, look_at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A plain look-at pinhole camera: (tan of horizontal angle, tan of vertical angle), and depth."""
+    forward = look_at - camera
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    rel = points - camera
+    depth = rel @ forward
+    return np.column_stack([rel @ right / depth, rel @ up / depth]), depth
+
+
+@dataclass
+class SlopesRun:
+    world: object
+    times: np.ndarray  # (T,) recorded times
+    frames: np.ndarray  # (T, balls, 15) trajectory rows
+    events: np.ndarray  # (K, 10) events without the kind column
+    kinds: np.ndarray  # (K,) "sphere-plane" / "sphere-sphere"
+
+
+@pytest.fixture(scope="module")
+def slopes_run(tmp_path_factory):
+    """The demo simulated headless for 10 s through the real CLI, every step recorded."""
+    tmp = tmp_path_factory.mktemp("slopes")
+    traj, events, kinds = simulate_csv(tmp, "slopes", "--duration", "10")
+    world = load_scene(SCENES / "slopes.toml")
+    n = len(world.spheres)
+    times = traj[::n, 0]
+    return SlopesRun(world, times, traj.reshape(len(times), n, 15), events, kinds)
+
+
+def test_slopes_scene_layout():
+    world = load_scene(SCENES / "slopes.toml")
+    planes = list(world.planes)
+    assert len(planes) == 5 and planes[GROUND].infinite and np.allclose(planes[GROUND].normal, [0, 1, 0])
+    slopes = planes[1:]
+    assert all(p.size is not None and p.size[0] == p.size[1] for p in slopes), "four squares"
+    tilts = {round(math.degrees(math.acos(p.normal[1])), 3) for p in slopes}
+    normals = {tuple(np.round(p.normal, 6)) for p in slopes}
+    assert len(tilts) == 4 and len(normals) == 4, "each tilted differently"
+    assert all(p.position[1] - 0.5 * p.size[0] > 0 for p in slopes), "slopes are above the ground"
+    heights = world.spheres.positions[:, 1]
+    assert len(heights) == 5 and heights.argmax() == 4, "the fifth ball starts highest"
+
+
+def test_slopes_every_slope_and_the_ground_is_hit(slopes_run):
+    events, kinds = slopes_run.events, slopes_run.kinds
+    plane_hits = events[kinds == "sphere-plane"]
+    hit_by = {int(b): set(plane_hits[plane_hits[:, 2] == b, 1].astype(int)) for b in SLOPES | {GROUND}}
+    assert all(hit_by[s] for s in SLOPES), hit_by
+    assert hit_by[GROUND] == set(range(5)), "every ball ends up on the ground"
+    first_plane = {a: int(plane_hits[plane_hits[:, 1] == a][0, 2]) for a in range(5)}
+    assert {first_plane[a] for a in range(4)} == SLOPES, "balls 0-3 each land on their own slope first"
+
+
+def _next_plane(plane_hits: np.ndarray, ball: int, t: float) -> int | None:
+    later = plane_hits[(plane_hits[:, 1] == ball) & (plane_hits[:, 0] > t)]
+    return int(later[0, 2]) if len(later) else None
+
+
+def test_slopes_balls_collide_in_mid_air_then_drop_to_the_ground(slopes_run):
+    run = slopes_run
+    world, times, frames, events, kinds = run.world, run.times, run.frames, run.events, run.kinds
+    plane_hits = events[kinds == "sphere-plane"]
+    midair = []
+    for t, a, b in events[kinds == "sphere-sphere"][:, :3]:
+        a, b = int(a), int(b)
+        k = min(np.searchsorted(times, t), len(times) - 1)
+        centres = frames[k, [a, b], 2:5]
+        clearance = min(float(np.min(p.distance(centres))) for p in world.planes) - RADIUS
+        bounced = all(
+            set(plane_hits[(plane_hits[:, 1] == ball) & (plane_hits[:, 0] < t), 2].astype(int)) & SLOPES
+            for ball in (a, b)
+        )
+        if clearance > 0.5 and bounced:
+            midair.append((round(t, 3), a, b, round(clearance, 2)))
+            assert _next_plane(plane_hits, a, t) == GROUND and _next_plane(plane_hits, b, t) == GROUND, (
+                t,
+                a,
+                b,
+            )
+    pairs = {(min(a, b), max(a, b)) for _, a, b, _ in midair}
+    assert len(pairs) >= 2, f"mid-air collisions after slope bounces: {midair}"
+    involved = {ball for pair in pairs for ball in pair}
+    assert 4 not in involved, "the fifth ball flies free"
+
+
+def test_slopes_fifth_ball_flies_far_with_the_highest_spin(slopes_run):
+    times, frames, events, kinds = slopes_run.times, slopes_run.frames, slopes_run.events, slopes_run.kinds
+    plane_hits = events[kinds == "sphere-plane"]
+    mine = plane_hits[plane_hits[:, 1] == 4]
+    (t_slope, _, slope, *_), (t_land, _, landed, *_) = mine[0], mine[mine[:, 2] != mine[0, 2]][0]
+    assert int(slope) in SLOPES and int(landed) == GROUND
+    touches = events[(kinds == "sphere-sphere") & ((events[:, 1] == 4) | (events[:, 2] == 4))]
+    assert not (touches[:, 0] < t_land).any(), "nothing touches it in flight"
+    i0, i1 = np.searchsorted(times, [t_slope, t_land])
+    flight = np.linalg.norm(frames[i1, 4, [2, 4]] - frames[i0, 4, [2, 4]])
+    assert flight > 8.0, f"it flies far: {flight:.2f} m"
+    spin = np.linalg.norm(frames[:, :, 8:11], axis=2)
+    in_flight = spin[i0 + 2 : i1 - 1, 4].min()
+    assert in_flight > spin[:, :4].max(), "in flight it spins faster than any other ball ever does"
+    assert spin[:, 4].max() == spin.max()
+
+
+def test_slopes_everything_stays_on_screen(slopes_run):
+    world, frames = slopes_run.world, slopes_run.frames
+    camera, look_at = world.scene.camera_position, world.scene.camera_look_at
+    centres = frames[:, :, 2:5].reshape(-1, 3)
+    tangents, depth = project(centres, camera, look_at)
+    half_v = math.tan(math.radians(30))  # 60° vertical field of view
+    half_h = half_v * 16 / 9
+    assert (depth > 1.0).all()
+    assert (np.abs(tangents[:, 0]) + RADIUS / depth < half_h).all()
+    assert (np.abs(tangents[:, 1]) + RADIUS / depth < half_v).all()
+    corners = []
+    for plane in list(world.planes)[1:]:
+        u, v = plane.axes
+        w, d = plane.size
+        corners += [plane.position + 0.5 * (su * w * u + sv * d * v) for su in (-1, 1) for sv in (-1, 1)]
+    tangents, _ = project(np.array(corners), camera, look_at)
+    assert (np.abs(tangents[:, 0]) < half_h).all() and (np.abs(tangents[:, 1]) < half_v).all()
