@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from ballpit.scene import bundled_scenes, load_scene
+from ballpit.viewer.camera import Camera
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
@@ -221,7 +222,7 @@ def test_slopes_everything_stays_on_screen(slopes_run):
     camera, look_at = world.scene.camera_position, world.scene.camera_look_at
     centres = frames[:, :, 2:5].reshape(-1, 3)
     tangents, depth = project(centres, camera, look_at)
-    half_v = math.tan(math.radians(30))  # 60° vertical field of view
+    half_v = math.tan(math.radians(Camera().fov_y_degrees / 2))  # the viewer's vertical field of view
     half_h = half_v * 16 / 9
     assert (depth > 1.0).all()
     assert (np.abs(tangents[:, 0]) + RADIUS / depth < half_h).all()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -54,8 +55,8 @@ def _size(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(
             f"must be WIDTHxHEIGHT in pixels, like 960x540, got {text!r}"
         ) from None
-    if w < 16 or h < 16 or w > 16384 or h > 16384:
-        raise argparse.ArgumentTypeError(f"must be between 16 and 16384 pixels each way, got {text!r}")
+    if w < 16 or h < 16 or w > 8192 or h > 8192:
+        raise argparse.ArgumentTypeError(f"must be between 16 and 8192 pixels each way, got {text!r}")
     return w, h
 
 
@@ -98,7 +99,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("render", help="render a scene offscreen to a GIF or a folder of PNG frames")
     p.add_argument("scene", help="a scene file, or a bundled scene's name")
-    p.add_argument("--out", type=Path, required=True, metavar="PATH", help="demo.gif, or a folder for frames")
+    p.add_argument(
+        "--out", required=True, metavar="PATH", help="demo.gif, frame.png, or a folder for PNG frames"
+    )
     p.add_argument("--duration", type=_positive, metavar="S", help="seconds to render (default: the scene's "
                    "[world] duration, else 10)")  # fmt: skip
     p.add_argument("--fps", type=_count, default=30, metavar="F", help="frames per second (default 30)")
@@ -229,17 +232,25 @@ def _view(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
+    from .writers import OutputError
 
     path = resolve_scene_path(args.scene)
     world = _load(str(path))
     duration = args.duration or world.scene.duration or 10.0
+    out = Path(args.out)
+    folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix
+    if not folder and out.suffix.lower() not in (".gif", ".png"):
+        raise OutputError(
+            f"{args.out}: --out must be a .gif, a .png or a folder for frames, not {out.suffix!r}"
+        )
     try:
         from .viewer.render import render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
-    result = render(path, args.out, duration=duration, fps=args.fps, size=args.size, progress=True)
-    return result if isinstance(result, int) else EXIT_OK
+    written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    print(f"wrote {written or out}")
+    return EXIT_OK
 
 
 def _bench(argv: list[str]) -> int:

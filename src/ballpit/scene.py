@@ -888,7 +888,9 @@ def _overlaps_in_ranges(positions, radii, tolerance, order, lo, hi, chunk_pairs:
         d = np.linalg.norm(positions[i] - positions[j], axis=1)
         bad = d < radii[i] + radii[j] - tolerance
         if bad.any():
-            return [(int(a), int(b)) for a, b in zip(i[bad], j[bad], strict=True)]
+            bi, bj = i[bad], j[bad]
+            k = np.lexsort((bi, bj))[0]  # the earliest later ball, then the earliest partner
+            return [(int(bi[k]), int(bj[k]))]
         start = stop
     return []
 
@@ -912,7 +914,7 @@ def _list(a: np.ndarray) -> list[float]:
 
 
 def _frame_scene(world: World) -> tuple[np.ndarray, np.ndarray]:
-    """A camera that sees every ball and finite plane: from the front, a little above, 60° tall view."""
+    """A camera that sees every ball and finite plane: from the front, a little above (50° tall view)."""
     points = [world.spheres.positions]
     for plane in world.planes:
         if plane.size is not None:
@@ -930,7 +932,7 @@ def _frame_scene(world: World) -> tuple[np.ndarray, np.ndarray]:
     radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1.0)
     direction = np.array([0.0, 0.35, 1.0])
     direction /= np.linalg.norm(direction)
-    distance = 1.15 * radius / math.sin(math.radians(30.0))
+    distance = 1.15 * radius / math.sin(math.radians(25.0))
     return look_at + distance * direction, look_at
 
 
