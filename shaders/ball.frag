@@ -3,7 +3,12 @@
 // (six segments around the ball's own y axis, white caps at its poles) is read in the ball's body
 // frame, so it turns with the orientation quaternion.
 
+#extension GL_ARB_conservative_depth : enable
 #include "common.glsl"
+
+#ifdef GL_ARB_conservative_depth
+layout(depth_greater) out float gl_FragDepth;   // see ball.vert: the sphere is behind its quad
+#endif
 
 in vec3 v_world;
 flat in vec4 v_center_radius;

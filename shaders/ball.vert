@@ -1,7 +1,7 @@
 #version 330 core
 // One camera-facing quad per ball (instanced); ball.frag ray-casts the exact sphere inside it.
-// The quad sits at the ball's centre, perpendicular to the eye→centre direction, and is just big
-// enough to hold the sphere's silhouette cone: half size d·r/√(d²−r²).
+// The quad is perpendicular to the eye→centre direction, on the sphere's nearest tangent plane, and
+// just big enough to hold the sphere's silhouette cone there: half size (d−r)·r/√(d²−r²).
 
 layout(location = 0) in vec2 a_corner;          // (±1, ±1), per vertex
 layout(location = 1) in vec4 a_center_radius;   // per instance: centre xyz, radius
@@ -33,8 +33,12 @@ void main() {
     vec3 helper = abs(w.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 u = normalize(cross(w, helper));
     vec3 v = cross(u, w);
-    float half_size = d * r / sqrt(d * d - r * r) * 1.05;   // a little margin for edge anti-aliasing
-    vec3 p = c + (u * a_corner.x + v * a_corner.y) * half_size;
+    // The quad sits on the tangent plane nearest the eye: every point of the sphere lies behind it
+    // along any eye ray, so the fragment depth only ever moves away from the quad's (depth_greater),
+    // which lets the depth test reject hidden balls before their fragments are shaded.
+    float front = d - r;
+    float half_size = front * r / sqrt(d * d - r * r) * 1.05;   // a little margin for edge anti-aliasing
+    vec3 p = u_eye + w * front + (u * a_corner.x + v * a_corner.y) * half_size;
     v_world = p;
     gl_Position = u_view_projection * vec4(p, 1.0);
 }

@@ -10,8 +10,8 @@ const vec3 SUN_COLOR = vec3(1.00, 0.96, 0.88);
 const vec3 SKY_AMBIENT = vec3(0.34, 0.38, 0.46);
 const vec3 GROUND_AMBIENT = vec3(0.16, 0.15, 0.14);
 
-vec3 to_linear(vec3 c) { return pow(max(c, vec3(0.0)), vec3(2.2)); }
-vec3 to_srgb(vec3 c) { return pow(max(c, vec3(0.0)), vec3(1.0 / 2.2)); }
+vec3 to_linear(vec3 c) { return c * c; }  // gamma 2: close to sRGB, much cheaper than pow on CPU GL
+vec3 to_srgb(vec3 c) { return sqrt(max(c, vec3(0.0))); }
 
 // Hemisphere ambient + one directional sun (Lambert) + Blinn-Phong highlight.
 vec3 shade(vec3 albedo_srgb, vec3 n, vec3 position, float shininess, float specular) {

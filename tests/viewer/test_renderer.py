@@ -176,6 +176,10 @@ def test_all_balls_are_one_instanced_draw_call(offscreen, count):
     assert balls[0].function == "glDrawArraysInstanced" and balls[0].instances == count
     assert [c.label for c in draws.calls] == ["planes", "balls"]
     assert not_background(image).any()
+    # many balls are uploaded nearest first; the picture is the same as in world order
+    offscreen.feeder.upload(Simulation(world))  # no eye: world order
+    unsorted = offscreen.draw(Camera.looking_at((0, 4, 12), (0, 2, 0)))
+    assert np.abs(unsorted.astype(int) - image.astype(int)).max() <= 2
 
 
 def test_overlays_draw_contacts_velocity_arrows_and_trails(offscreen):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 import os
 
 import numpy as np
@@ -50,7 +51,7 @@ def test_nothing_moves_while_waiting_for_x():
 
 
 def test_steps_are_fixed_and_the_accumulator_keeps_the_remainder():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     dt = sim.timestep
     fed = 0.0
@@ -63,7 +64,7 @@ def test_steps_are_fixed_and_the_accumulator_keeps_the_remainder():
 
 
 def test_a_long_frame_catches_up_at_most_the_frame_cap():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)  # no wall-time limit: only the cap
     sim.start()
     steps = sim.advance(10.0)
     assert steps == pytest.approx(MAX_FRAME_SECONDS / sim.timestep, abs=1)
@@ -81,7 +82,7 @@ def test_slow_physics_drops_the_backlog_instead_of_spiralling():
 
 
 def test_rendering_interpolates_between_the_last_two_steps():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     dt = sim.timestep
     sim.advance(10.5 * dt)
@@ -95,7 +96,7 @@ def test_rendering_interpolates_between_the_last_two_steps():
 
 
 def test_pause_freezes_and_single_steps_advance_exactly_one_timestep():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     sim.advance(0.05)
     sim.toggle_pause()
@@ -113,7 +114,7 @@ def test_pause_freezes_and_single_steps_advance_exactly_one_timestep():
 
 
 def test_single_step_is_ignored_unless_paused():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.step_once()
     assert sim.world.time == 0.0
     assert "paused" in sim.message
@@ -136,7 +137,7 @@ def test_reset_restores_the_initial_state_and_waits_for_x_again():
 
 
 def test_time_scale_speeds_up_simulated_time():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     sim.faster()
     sim.advance(0.1)
@@ -152,7 +153,7 @@ def test_kinetic_energy_counts_translation_and_spin():
 
 
 def test_trails_keep_recent_positions_oldest_first_within_a_budget():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     for _ in range(30):
         sim.advance(1 / 30)
@@ -206,7 +207,7 @@ def test_saving_the_file_is_noticed_and_a_good_reload_replaces_the_world(tmp_pat
 
 
 def test_a_world_built_in_code_cannot_be_reloaded_but_keeps_running():
-    sim = Simulation(drifting_world())
+    sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
     assert sim.reload() is False
     assert "no scene file" in sim.error

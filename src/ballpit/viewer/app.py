@@ -233,7 +233,7 @@ class Viewer:
                 self.reload()
 
         self.window.switch_to()
-        self.feeder.upload(self.sim, self.flags)
+        self.feeder.upload(self.sim, self.flags, self.camera.position)
         width, height = self.window.get_framebuffer_size()
         self.renderer.draw(self.camera, width, height, multisample=self.multisample)
         self._draw_hud(now)

@@ -43,6 +43,7 @@ def _select(mode: str) -> None:
             f"this process already uses pyglet in {chosen} mode and cannot switch to {mode} mode; "
             "run the viewer and offscreen rendering in separate processes"
         )
+    _check_pyopengl(mode)
     if "OpenGL.GL" not in sys.modules:
         if mode == "headless":
             os.environ["PYOPENGL_PLATFORM"] = "egl"
@@ -56,6 +57,19 @@ def _select(mode: str) -> None:
         pyglet.options["headless"] = mode == "headless"
         # The shadow window only helps share objects between windows; ballpit opens one.
         pyglet.options["shadow_window"] = False
+
+
+def _check_pyopengl(mode: str) -> None:
+    """PyOpenGL imported before the mode was chosen may have picked the wrong loader: say so clearly."""
+    if "OpenGL.platform" not in sys.modules:
+        return
+    platform = type(sys.modules["OpenGL.platform"].PLATFORM).__name__  # e.g. EGLPlatform, GLXPlatform
+    wanted = {"headless": "EGL"}.get(mode) or ("GLX" if sys.platform.startswith("linux") else None)
+    if wanted is not None and not platform.startswith(wanted):
+        raise BackendError(
+            f"PyOpenGL was imported with the {platform} loader before ballpit chose {mode} mode (which needs "
+            f"{wanted}); import ballpit.viewer before OpenGL, or set PYOPENGL_PLATFORM={wanted.lower()}"
+        )
 
 
 def display_problem() -> str | None:

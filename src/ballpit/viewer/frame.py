@@ -31,7 +31,11 @@ class FrameFeeder:
         self._sim: Simulation | None = None
         self.upload_seconds = 0.0
 
-    def upload(self, sim: Simulation, flags: OverlayFlags | None = None) -> None:
+    def upload(
+        self, sim: Simulation, flags: OverlayFlags | None = None, eye: np.ndarray | None = None
+    ) -> None:
+        """Upload this frame's balls (sorted nearest first when ``eye`` is given), lines and, when the
+        scene changed, planes."""
         started = time.perf_counter()
         flags = flags or OverlayFlags()
         look = sim.appearance
@@ -44,7 +48,7 @@ class FrameFeeder:
             self._sim, self._generation = sim, sim.generation
         positions, orientations = sim.render_state()
         spheres = world.spheres
-        self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors)
+        self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors, eye)
 
         world_lines, overlay_lines = overlays.empty(), overlays.empty()
         if flags.trails and sim.trails.filled:

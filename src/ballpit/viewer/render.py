@@ -55,7 +55,7 @@ class Offscreen:
     def render(self, sim: Simulation, camera: Camera, flags: object = None) -> np.ndarray:
         """Upload the simulation's current (interpolated) state and draw it."""
         self.window.switch_to()
-        self.feeder.upload(sim, flags)  # type: ignore[arg-type]
+        self.feeder.upload(sim, flags, camera.position)  # type: ignore[arg-type]
         return self.draw(camera)
 
     def close(self) -> None:
