@@ -320,3 +320,18 @@ def test_python_m_and_console_script_agree():
     script = Path(sys.executable).parent / "ballpit"
     r = subprocess.run([str(script), "check", "scenes/slopes.toml"], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0 and "ok" in r.stdout
+
+
+def test_view_validates_the_scene_before_opening_a_window(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[[sphere]]\nposition = [0, 1, 0]\nradius = 0\n")
+    assert_user_error(ballpit("view", bad), "bad.toml:3:", "key 'radius'")
+    assert_user_error(ballpit(bad), "bad.toml:3:", "key 'radius'")  # a scene file alone means view
+    assert_user_error(ballpit("view", tmp_path / "missing.toml"), "missing.toml", "no such file")
+
+
+def test_scenes_lists_the_bundled_scenes():
+    r = ballpit("scenes")
+    assert r.returncode == 0
+    names = [line.split()[0] for line in r.stdout.splitlines()]
+    assert {"slopes", "cradle", "billiards", "incline", "pile", "pile10k"} <= set(names)
