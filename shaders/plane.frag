@@ -31,8 +31,8 @@ void main() {
     vec3 n = gl_FrontFacing ? v_normal : -v_normal;
     vec2 cell = floor(v_local);
     float checker = mod(cell.x + cell.y, 2.0);
-    vec3 albedo = v_color * mix(0.86, 1.0, checker);
-    albedo = mix(albedo, albedo * 0.55, grid(v_local, 1.0, 1.0));
+    vec3 albedo = v_color * mix(0.90, 1.0, checker);
+    albedo = mix(albedo, albedo * 0.65, grid(v_local, 1.0, 1.0));
     if (!gl_FrontFacing) albedo *= 0.75;
 
     // edge band of finite planes

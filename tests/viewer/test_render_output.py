@@ -45,6 +45,9 @@ def test_render_writes_an_animated_gif_of_the_drop_starting_at_once(offscreen, t
     assert len(frames) == 6
     assert frames[0].shape == (64, 96, 3)
     assert np.abs(frames[0].astype(int) - frames[-1].astype(int)).max() > 60  # the ball has fallen
+    first = frames[0].astype(int)
+    red = (first[..., 0] > first[..., 1] + 60) & (first[..., 0] > first[..., 2] + 60)
+    assert red.sum() >= 4  # the small red ball keeps its colour through the GIF palette
     err = capsys.readouterr().err
     assert "rendering drop.toml" in err and "6/6" in err  # tqdm progress bar on stderr
 

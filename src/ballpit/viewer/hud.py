@@ -15,7 +15,7 @@ FONT = ("DejaVu Sans Mono", "Menlo", "Consolas", "Courier New", "monospace")
 FONT_SIZE = 11
 TEXT_COLOR = (235, 238, 245, 255)
 ERROR_COLOR = (255, 110, 100, 255)
-PANEL_COLOR = (10, 12, 18, 170)
+PANEL_COLOR = (10, 12, 18, 190)
 MARGIN = 10
 MESSAGE_SECONDS = 3.0
 

@@ -71,6 +71,26 @@ class Offscreen:
         self.close()
 
 
+def gif_palette(sample: np.ndarray, sphere_colors: np.ndarray, ramps: int = 8, shades: int = 8):
+    """One 256-colour palette for every GIF frame: the sample frame's main colours (median cut) plus
+    shades of the commonest ball colours, which are too few pixels to survive a plain median cut."""
+    from PIL import Image
+
+    colors, counts = np.unique(
+        np.round(np.asarray(sphere_colors) * 255).astype(int), axis=0, return_counts=True
+    )
+    chosen = colors[np.argsort(-counts)[:ramps]]
+    k = np.linspace(0.35, 1.15, shades)[None, :, None]
+    ramp = np.clip(chosen[:, None, :] * k + np.maximum(k - 1.0, 0.0) * 255, 0, 255).reshape(-1, 3)
+    base_count = 256 - len(ramp)
+    base = Image.fromarray(sample).quantize(colors=base_count, method=Image.Quantize.MEDIANCUT).getpalette()
+    entries = list(base[: base_count * 3]) + [int(v) for v in ramp.reshape(-1)]
+    entries += [0] * (768 - len(entries))
+    palette = Image.new("P", (1, 1))
+    palette.putpalette(entries)
+    return palette
+
+
 def _output_kind(out: Path, raw: str) -> str:
     if raw.endswith(("/", os.sep)) or out.is_dir() or not out.suffix:
         return "frames"
@@ -138,6 +158,7 @@ def render_world(
     camera = Camera.looking_at(look.camera_position, look.camera_look_at)
     sim.start()
     images: list[Image.Image] = []
+    palette: Image.Image | None = None
     last: np.ndarray | None = None
     with Offscreen((width, height), samples) as screen:
         bar = tqdm(
@@ -154,7 +175,9 @@ def render_world(
             if kind == "frames":
                 Image.fromarray(last).save(out / f"frame_{index:04d}.png")
             elif kind == "gif":
-                images.append(Image.fromarray(last).quantize(colors=255, method=Image.Quantize.MEDIANCUT))
+                if palette is None:
+                    palette = gif_palette(last, look.sphere_colors)
+                images.append(Image.fromarray(last).quantize(palette=palette, dither=Image.Dither.NONE))
     if kind == "gif":
         images[0].save(
             out, save_all=True, append_images=images[1:], duration=round(1000.0 / fps), loop=0, disposal=1
