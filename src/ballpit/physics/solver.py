@@ -46,19 +46,10 @@ class ContactBatch:
     def __len__(self) -> int:
         return len(self.a)
 
-    @property
-    def normal_mass(self) -> np.ndarray:
-        return 1.0 / (self.inv_mass_a + self.inv_mass_b)
-
-    @property
-    def tangent_mass(self) -> np.ndarray:
-        ra2 = np.einsum("ij,ij->i", self.arm_a, self.arm_a)
-        rb2 = np.einsum("ij,ij->i", self.arm_b, self.arm_b)
-        return 1.0 / (self.inv_mass_a + ra2 * self.inv_inertia_a + self.inv_mass_b + rb2 * self.inv_inertia_b)
-
-    @property
-    def rolling_mass(self) -> np.ndarray:
-        return 1.0 / np.maximum(self.inv_inertia_a + self.inv_inertia_b, 1e-300)
+    def subset(self, mask: np.ndarray, static: int) -> ContactBatch:
+        """The contacts where ``mask`` holds, coloured afresh."""
+        fields = {k: v[mask] for k, v in vars(self).items() if k != "colours"}
+        return ContactBatch(**fields, colours=colour(fields["a"], fields["b"], static))
 
 
 @dataclass
@@ -106,28 +97,69 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
 def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """Scale each row down to length ≤ limit (the friction cone and the rolling-resistance limit)."""
     length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors))
-    scale = np.where(length > limit, limit / np.where(length > 0, length, 1.0), 1.0)
+    over = length > limit
+    if not over.any():
+        return vectors
+    scale = np.where(over, limit / np.where(over, length, 1.0), 1.0)
     return vectors * scale[:, None]
 
 
-def apply(batch: ContactBatch, idx: np.ndarray, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
-    """Add the impulses of contacts ``idx`` to the velocities (contacts in idx share no ball)."""
-    a, b = batch.a[idx], batch.b[idx]
-    linear = imp.normal[idx, None] * batch.normal[idx] + imp.friction[idx]
-    v[a] += linear * batch.inv_mass_a[idx, None]
-    v[b] -= linear * batch.inv_mass_b[idx, None]
-    w[a] += (np.cross(batch.arm_a[idx], imp.friction[idx]) + imp.rolling[idx]) * batch.inv_inertia_a[
-        idx, None
-    ]
-    w[b] -= (np.cross(batch.arm_b[idx], imp.friction[idx]) + imp.rolling[idx]) * batch.inv_inertia_b[
-        idx, None
-    ]
+def skew(n: np.ndarray) -> np.ndarray:
+    """Matrices [n]× with [n]×·s = n × s, so a batch of cross products is one einsum."""
+    k = np.zeros((len(n), 3, 3))
+    k[:, 0, 1], k[:, 0, 2] = -n[:, 2], n[:, 1]
+    k[:, 1, 0], k[:, 1, 2] = n[:, 2], -n[:, 0]
+    k[:, 2, 0], k[:, 2, 1] = -n[:, 1], n[:, 0]
+    return k
+
+
+class _Colour:
+    """One colour's contacts, gathered once per solve so the iterations only touch velocities.
+
+    With arms r_a = −ρ_a·n and r_b = +ρ_b·n (ρ the radii), the contact-point velocity is
+    v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n, and a tangential impulse P turns the balls by
+    Δω_a = −ρ_a·I_a⁻¹·(n × P), Δω_b = −ρ_b·I_b⁻¹·(n × P).
+    """
+
+    def __init__(self, batch: ContactBatch, idx: np.ndarray) -> None:
+        self.idx = idx
+        self.a, self.b = batch.a[idx], batch.b[idx]
+        self.n = batch.normal[idx]
+        self.nx = skew(self.n)
+        ra = np.sqrt(np.einsum("ij,ij->i", batch.arm_a[idx], batch.arm_a[idx]))
+        rb = np.sqrt(np.einsum("ij,ij->i", batch.arm_b[idx], batch.arm_b[idx]))
+        self.ra, self.rb = ra[:, None], rb[:, None]
+        self.ima, self.imb = batch.inv_mass_a[idx, None], batch.inv_mass_b[idx, None]
+        self.iia, self.iib = batch.inv_inertia_a[idx, None], batch.inv_inertia_b[idx, None]
+        self.turn_a, self.turn_b = self.ra * self.iia, self.rb * self.iib
+        self.m_n = 1.0 / (batch.inv_mass_a[idx] + batch.inv_mass_b[idx])
+        self.m_t = (1.0 / (self.ima + ra[:, None] ** 2 * self.iia + self.imb + rb[:, None] ** 2 * self.iib))
+        self.m_r = 1.0 / np.maximum(self.iia + self.iib, 1e-300)
+        self.mu = batch.friction[idx]
+        self.roll = batch.rolling[idx]
 
 
 def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
     """Apply impulses carried over from the previous interval before iterating."""
-    for idx in batch.colours:
-        apply(batch, idx, v, w, imp)
+    if len(batch) == 0:
+        return
+    n = batch.normal
+    linear = imp.normal[:, None] * n + imp.friction
+    turn = np.einsum("kij,kj->ki", skew(n), imp.friction)  # n × P_t
+    ra = np.sqrt(np.einsum("ij,ij->i", batch.arm_a, batch.arm_a))[:, None]
+    rb = np.sqrt(np.einsum("ij,ij->i", batch.arm_b, batch.arm_b))[:, None]
+    rows = len(v)
+    for body, sign, im, ii, r in (
+        (batch.a, 1.0, batch.inv_mass_a, batch.inv_inertia_a, ra),
+        (batch.b, -1.0, batch.inv_mass_b, batch.inv_inertia_b, rb),
+    ):
+        dv = sign * linear * im[:, None]
+        dw = (-r * turn + sign * imp.rolling) * ii[:, None]
+        for axis in range(3):
+            v[:, axis] += np.bincount(body, dv[:, axis], minlength=rows)
+            w[:, axis] += np.bincount(body, dw[:, axis], minlength=rows)
+    v[-1] = 0.0
+    w[-1] = 0.0
 
 
 def solve(
@@ -142,46 +174,50 @@ def solve(
     rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates."""
     if len(batch) == 0:
         return imp
-    m_n, m_t, m_r = batch.normal_mass, batch.tangent_mass, batch.rolling_mass
+    colours = [_Colour(batch, idx) for idx in batch.colours]
+    targets = [target[c.idx] for c in colours]
+    normal = [imp.normal[c.idx] for c in colours]
+    friction = [imp.friction[c.idx] for c in colours]
+    rolling = [imp.rolling[c.idx] for c in colours]
     for _ in range(iterations):
-        for idx in batch.colours:
-            a, b = batch.a[idx], batch.b[idx]
-            n, ra, rb = batch.normal[idx], batch.arm_a[idx], batch.arm_b[idx]
-            ima, imb = batch.inv_mass_a[idx, None], batch.inv_mass_b[idx, None]
-            iia, iib = batch.inv_inertia_a[idx, None], batch.inv_inertia_b[idx, None]
-            va, vb, wa, wb = v[a], v[b], w[a], w[b]
+        for k, c in enumerate(colours):
+            va, vb, wa, wb = v[c.a], v[c.b], w[c.a], w[c.b]
+            # contact-point velocity of a relative to b: v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n
+            spin = c.ra * wa + c.rb * wb
+            rel = va - vb + np.einsum("kij,kj->ki", c.nx, spin)
+            vn = np.einsum("ij,ij->i", rel, c.n)
 
-            # normal: accumulated impulse stays ≥ 0
-            rel = va + np.cross(wa, ra) - vb - np.cross(wb, rb)
-            vn = np.einsum("ij,ij->i", rel, n)
-            old = imp.normal[idx]
-            new = np.maximum(old + m_n[idx] * (target[idx] - vn), 0.0)
-            imp.normal[idx] = new
-            dp = (new - old)[:, None] * n
-            va = va + dp * ima
-            vb = vb - dp * imb
+            # normal: the accumulated impulse stays ≥ 0
+            old = normal[k]
+            new = np.maximum(old + c.m_n * (targets[k] - vn), 0.0)
+            normal[k] = new
 
-            # friction: cancel slip at the contact point, inside the cone |P_t| ≤ μ·P_n
-            rel = va + np.cross(wa, ra) - vb - np.cross(wb, rb)
-            slip = rel - np.einsum("ij,ij->i", rel, n)[:, None] * n
-            old_t = imp.friction[idx]
-            new_t = _cap(old_t - m_t[idx, None] * slip, batch.friction[idx] * new)
-            imp.friction[idx] = new_t
-            dt_ = new_t - old_t
-            va = va + dt_ * ima
-            vb = vb - dt_ * imb
-            wa = wa + np.cross(ra, dt_) * iia
-            wb = wb - np.cross(rb, dt_) * iib
+            # friction: cancel slip (the tangential part of rel, which the normal impulse leaves
+            # alone), inside the Coulomb cone |P_t| ≤ μ·P_n
+            slip = rel - vn[:, None] * c.n
+            old_t = friction[k]
+            new_t = _cap(old_t - c.m_t * slip, c.mu * new)
+            friction[k] = new_t
+            d_t = new_t - old_t
+            turn = np.einsum("kij,kj->ki", c.nx, d_t)  # n × ΔP_t
+            wa = wa - c.turn_a * turn
+            wb = wb - c.turn_b * turn
 
             # rolling resistance: oppose relative spin, up to ρ·r·P_n
-            old_r = imp.rolling[idx]
-            new_r = _cap(old_r - m_r[idx, None] * (wa - wb), batch.rolling[idx] * new)
-            imp.rolling[idx] = new_r
-            dr = new_r - old_r
-            wa = wa + dr * iia
-            wb = wb - dr * iib
+            old_r = rolling[k]
+            new_r = _cap(old_r - c.m_r * (wa - wb), c.roll * new)
+            rolling[k] = new_r
+            d_r = new_r - old_r
 
-            v[a], v[b], w[a], w[b] = va, vb, wa, wb
+            linear = (new - old)[:, None] * c.n + d_t
+            v[c.a] = va + c.ima * linear
+            v[c.b] = vb - c.imb * linear
+            w[c.a] = wa + c.iia * d_r
+            w[c.b] = wb - c.iib * d_r
         v[-1] = 0.0
         w[-1] = 0.0
+    for k, c in enumerate(colours):
+        imp.normal[c.idx] = normal[k]
+        imp.friction[c.idx] = friction[k]
+        imp.rolling[c.idx] = rolling[k]
     return imp
