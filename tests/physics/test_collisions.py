@@ -14,7 +14,9 @@ def run(world: ballpit.World, steps: int, dt: float = 1 / 240) -> list:
     return [world.step(dt) for _ in range(steps)]
 
 
-@pytest.mark.parametrize(("m1", "m2", "e"), [(1.0, 1.0, 1.0), (1.0, 3.0, 1.0), (2.0, 0.5, 0.6), (1.0, 1.0, 0.0)])
+@pytest.mark.parametrize(
+    ("m1", "m2", "e"), [(1.0, 1.0, 1.0), (1.0, 3.0, 1.0), (2.0, 0.5, 0.6), (1.0, 1.0, 0.0)]
+)
 def test_head_on_collision_matches_the_closed_form(m1, m2, e):
     world = zero_g()
     u1, u2 = 3.0, -1.0

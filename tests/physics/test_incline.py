@@ -32,8 +32,12 @@ def test_ball_rolls_at_five_sevenths_g_sin_theta(integrator):
     assert travelled == pytest.approx(0.5 * a * t * t, rel=1e-6)
     assert ball.velocity == pytest.approx(a * t * downhill, abs=1e-6)
     # rolling without slipping: ω = n × v / r
-    assert ball.angular_velocity == pytest.approx(np.cross(slope.normal, ball.velocity) / ball.radius, abs=1e-6)
-    assert np.dot(ball.position, slope.normal) == pytest.approx(ball.radius, abs=1e-6)  # neither sinks nor hops
+    assert ball.angular_velocity == pytest.approx(
+        np.cross(slope.normal, ball.velocity) / ball.radius, abs=1e-6
+    )
+    assert np.dot(ball.position, slope.normal) == pytest.approx(
+        ball.radius, abs=1e-6
+    )  # neither sinks nor hops
 
 
 def test_hollow_ball_rolls_at_three_fifths_g_sin_theta():
@@ -42,7 +46,9 @@ def test_hollow_ball_rolls_at_three_fifths_g_sin_theta():
     for _ in range(240):
         world.step(1 / 240)
     # a = g sin θ / (1 + I/(m r²)) with I = 2/3 m r²
-    assert np.dot(ball.velocity, downhill) == pytest.approx(3 / 5 * G * math.sin(math.radians(theta)), rel=1e-6)
+    assert np.dot(ball.velocity, downhill) == pytest.approx(
+        3 / 5 * G * math.sin(math.radians(theta)), rel=1e-6
+    )
 
 
 def test_ball_slides_at_g_sin_minus_mu_cos_and_spins_up_at_five_halves_mu_g_cos_over_r():
@@ -54,7 +60,9 @@ def test_ball_slides_at_g_sin_minus_mu_cos_and_spins_up_at_five_halves_mu_g_cos_
     c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
     assert np.dot(ball.velocity, downhill) == pytest.approx(G * (s - mu * c) * t, rel=1e-6)
     spin_axis = np.cross(slope.normal, downhill)
-    assert np.dot(ball.angular_velocity, spin_axis) == pytest.approx(2.5 * mu * G * c / ball.radius * t, rel=1e-6)
+    assert np.dot(ball.angular_velocity, spin_axis) == pytest.approx(
+        2.5 * mu * G * c / ball.radius * t, rel=1e-6
+    )
     # still slipping: the contact point moves downhill
     slip = ball.velocity + np.cross(ball.angular_velocity, -ball.radius * slope.normal)
     assert np.dot(slip, downhill) > 0.1

@@ -24,6 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# A sweep that changes no contact velocity by more than this (m/s) ends the iterations early.
+CONVERGED = 1e-9
+
 
 @dataclass
 class ContactBatch:
@@ -96,11 +99,11 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
 
 def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """Scale each row down to length ≤ limit (the friction cone and the rolling-resistance limit)."""
-    length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors))
-    over = length > limit
+    length2 = np.einsum("ij,ij->i", vectors, vectors)
+    over = length2 > limit * limit
     if not over.any():
         return vectors
-    scale = np.where(over, limit / np.where(over, length, 1.0), 1.0)
+    scale = np.where(over, limit / np.sqrt(np.where(over, length2, 1.0)), 1.0)
     return vectors * scale[:, None]
 
 
@@ -132,11 +135,14 @@ class _Colour:
         self.ima, self.imb = batch.inv_mass_a[idx, None], batch.inv_mass_b[idx, None]
         self.iia, self.iib = batch.inv_inertia_a[idx, None], batch.inv_inertia_b[idx, None]
         self.turn_a, self.turn_b = self.ra * self.iia, self.rb * self.iib
-        self.m_n = 1.0 / (batch.inv_mass_a[idx] + batch.inv_mass_b[idx])
-        self.m_t = (1.0 / (self.ima + ra[:, None] ** 2 * self.iia + self.imb + rb[:, None] ** 2 * self.iib))
+        self.inv_m_n = batch.inv_mass_a[idx] + batch.inv_mass_b[idx]
+        self.m_n = 1.0 / self.inv_m_n
+        self.m_t = 1.0 / (self.ima + ra[:, None] ** 2 * self.iia + self.imb + rb[:, None] ** 2 * self.iib)
         self.m_r = 1.0 / np.maximum(self.iia + self.iib, 1e-300)
         self.mu = batch.friction[idx]
         self.roll = batch.rolling[idx]
+        self.has_friction = bool(self.mu.any())
+        self.has_rolling = bool(self.roll.any())
 
 
 def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -180,6 +186,7 @@ def solve(
     friction = [imp.friction[c.idx] for c in colours]
     rolling = [imp.rolling[c.idx] for c in colours]
     for _ in range(iterations):
+        change = 0.0  # the largest velocity change this sweep made at any contact (m/s)
         for k, c in enumerate(colours):
             va, vb, wa, wb = v[c.a], v[c.b], w[c.a], w[c.b]
             # contact-point velocity of a relative to b: v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n
@@ -191,31 +198,40 @@ def solve(
             old = normal[k]
             new = np.maximum(old + c.m_n * (targets[k] - vn), 0.0)
             normal[k] = new
+            linear = (new - old)[:, None] * c.n
+            change = max(change, float(np.max(np.abs(new - old) * c.inv_m_n)))
 
-            # friction: cancel slip (the tangential part of rel, which the normal impulse leaves
-            # alone), inside the Coulomb cone |P_t| ≤ μ·P_n
-            slip = rel - vn[:, None] * c.n
-            old_t = friction[k]
-            new_t = _cap(old_t - c.m_t * slip, c.mu * new)
-            friction[k] = new_t
-            d_t = new_t - old_t
-            turn = np.einsum("kij,kj->ki", c.nx, d_t)  # n × ΔP_t
-            wa = wa - c.turn_a * turn
-            wb = wb - c.turn_b * turn
+            if c.has_friction:
+                # friction: cancel slip (the tangential part of rel, which the normal impulse leaves
+                # alone), inside the Coulomb cone |P_t| ≤ μ·P_n
+                slip = rel - vn[:, None] * c.n
+                old_t = friction[k]
+                new_t = _cap(old_t - c.m_t * slip, c.mu * new)
+                friction[k] = new_t
+                d_t = new_t - old_t
+                turn = np.einsum("kij,kj->ki", c.nx, d_t)  # n × ΔP_t
+                wa = wa - c.turn_a * turn
+                wb = wb - c.turn_b * turn
+                linear += d_t
+                change = max(change, float(np.max(np.abs(d_t) / c.m_t)))
 
-            # rolling resistance: oppose relative spin, up to ρ·r·P_n
-            old_r = rolling[k]
-            new_r = _cap(old_r - c.m_r * (wa - wb), c.roll * new)
-            rolling[k] = new_r
-            d_r = new_r - old_r
+            if c.has_rolling:
+                # rolling resistance: oppose relative spin, up to ρ·r·P_n
+                old_r = rolling[k]
+                new_r = _cap(old_r - c.m_r * (wa - wb), c.roll * new)
+                rolling[k] = new_r
+                d_r = new_r - old_r
+                wa = wa + c.iia * d_r
+                wb = wb - c.iib * d_r
 
-            linear = (new - old)[:, None] * c.n + d_t
             v[c.a] = va + c.ima * linear
             v[c.b] = vb - c.imb * linear
-            w[c.a] = wa + c.iia * d_r
-            w[c.b] = wb - c.iib * d_r
+            w[c.a] = wa
+            w[c.b] = wb
         v[-1] = 0.0
         w[-1] = 0.0
+        if change < CONVERGED:
+            break
     for k, c in enumerate(colours):
         imp.normal[c.idx] = normal[k]
         imp.friction[c.idx] = friction[k]
