@@ -42,7 +42,7 @@ def test_ball_rolls_at_five_sevenths_g_sin_theta(integrator):
 
 def test_hollow_ball_rolls_at_three_fifths_g_sin_theta():
     theta = 20.0
-    world, slope, ball, downhill = ball_on_incline(theta, 0.5, hollow=True)
+    world, _slope, ball, downhill = ball_on_incline(theta, 0.5, hollow=True)
     for _ in range(240):
         world.step(1 / 240)
     # a = g sin θ / (1 + I/(m r²)) with I = 2/3 m r²
