@@ -70,7 +70,8 @@ class Candidates:
     pair_j: np.ndarray
     sphere: np.ndarray  # sphere–plane pairs
     plane: np.ndarray
-    side: np.ndarray  # ±1: the side of the plane the ball was on when the pair was found
+    side: np.ndarray  # ±1: the side of the plane the ball is on
+    counts: tuple[int, int]  # balls and planes in the world when the pairs were found
 
     def __len__(self) -> int:
         return len(self.pair_i) + len(self.sphere)

@@ -90,10 +90,9 @@ def derivative(q: np.ndarray, omega: np.ndarray, out: np.ndarray) -> np.ndarray:
 
     With the pure quaternion (ω, 0) on the left: vector part ½(q_w·ω + ω × q_v), scalar −½ ω·q_v.
     """
-    qx, qy, qz, qw = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    wx, wy, wz = omega[:, 0], omega[:, 1], omega[:, 2]
-    out[:, 0] = 0.5 * (qw * wx + wy * qz - wz * qy)
-    out[:, 1] = 0.5 * (qw * wy + wz * qx - wx * qz)
-    out[:, 2] = 0.5 * (qw * wz + wx * qy - wy * qx)
-    out[:, 3] = -0.5 * (wx * qx + wy * qy + wz * qz)
+    half = 0.5 * omega
+    qv = q[:, :3]
+    np.multiply(q[:, 3:4], half, out=out[:, :3])
+    out[:, :3] += np.cross(half, qv)
+    out[:, 3] = -np.einsum("ij,ij->i", half, qv)
     return out

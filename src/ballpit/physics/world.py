@@ -23,6 +23,10 @@ APPROACH_SPEED = 1e-6
 # Impacts whose times are this close (as an overlap, in radii) are resolved together. Merging more
 # than simultaneous impacts (0) made piles slower to settle in tests, so it is off by default.
 IMPACT_OVERLAP = 0.0
+# Broad-phase boxes cover this many steps of each ball's path, so most steps reuse the pairs.
+BROAD_PHASE_STEPS = 4
+# … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
+BROAD_PHASE_MARGIN = 0.25
 # A step is split at most this many times; past it the rest of the step is taken whole.
 MAX_INTERVALS = 10_000
 # Explicit Euler's default restitution threshold, in units of |g|·dt (see _bounce_threshold).
@@ -56,6 +60,7 @@ class World:
         # Resting contact forces from the last interval, by pair key, to warm-start the solver.
         self._warm_keys = np.zeros(0, np.int64)
         self._warm_forces = Impulses.zeros(0)
+        self._candidates: Candidates | None = None
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -277,7 +282,7 @@ class World:
         forces = self.forces()
         threshold = self._bounce_threshold(dt)
         events = EventLog()
-        candidates = self._broad_phase(dt, self._free_acceleration(forces)[0])
+        candidates = self._candidate_pairs(dt, self._free_acceleration(forces)[0])
         elapsed, intervals = 0.0, 0
         while elapsed < dt:
             remaining = dt - elapsed
@@ -287,17 +292,21 @@ class World:
             self._remove_penetration(touching, batch)
             now = self.time + elapsed
             self._bounce(touching, batch, threshold, events, now)
-            push = self._resting_forces(touching, batch, forces, remaining, events, now)
-            lin = self._free_acceleration(forces)[0] + push.lin
+            lin, ang = self._free_acceleration(forces)
+            push = self._resting_forces(touching, batch, lin, ang, remaining, events, now)
+            if push is not None:
+                lin += push.lin
             if self._escapes_boxes(candidates, lin, remaining):
-                candidates = self._broad_phase(remaining, lin)
+                candidates = self._broad_phase(remaining + (BROAD_PHASE_STEPS - 1) * dt, lin)
                 contacts = self._narrow_phase(candidates)
             intervals += 1
             if intervals < MAX_INTERVALS:
                 h = min(self._next_impact(contacts, lin, remaining), remaining)
             else:  # a pathological pile-up: finish the step without splitting it further
                 h = remaining
-            integrate(self._integrator, state, [*forces, push], h, self._workspace)
+            integrate(
+                self._integrator, state, forces if push is None else [*forces, push], h, self._workspace
+            )
             events.close_interval(h / remaining)
             elapsed = dt if h >= remaining else elapsed + h
         self._reject_non_finite(before)
@@ -322,17 +331,37 @@ class World:
             end += 0.5 * h * h * accel
         return end
 
+    def _candidate_pairs(self, dt: float, accel: np.ndarray) -> Candidates:
+        """The broad phase's pairs, kept from earlier steps while every ball's path stays in its box.
+
+        Boxes are swept over BROAD_PHASE_STEPS steps ahead, so most steps reuse them; the side each
+        ball is on of each plane is refreshed every step (a ball moved by hand may have crossed one).
+        """
+        c = self._candidates
+        counts = (self._spheres.count, self._planes.count)
+        if c is None or c.counts != counts or self._escapes_boxes(c, accel, dt):
+            c = self._candidates = self._broad_phase(BROAD_PHASE_STEPS * dt, accel)
+        elif len(c.sphere):
+            pl = self._planes
+            signed = np.einsum(
+                "ij,ij->i", self._spheres.state[c.sphere, 0:3] - pl.center[c.plane], pl.normal[c.plane]
+            )
+            c.side = np.where(signed < 0.0, -1.0, 1.0)
+        return c
+
     def _broad_phase(self, h: float, accel: np.ndarray) -> Candidates:
         """Candidate pairs for the next ``h`` seconds, from boxes around each ball's swept path."""
         state, radius = self._spheres.state, self._spheres.radius
         x = state[:, X]
-        margin = np.linalg.norm(accel, axis=1) * h * h + 0.02 * radius + CONTACT_SLOP
+        margin = np.linalg.norm(accel, axis=1) * h * h + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP
         lo, hi = broadphase.swept_boxes(x, self._path_end(accel, h), radius, margin)
         i, j = broadphase.sphere_pairs(lo, hi)
         pl = self._planes
         s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
         signed = np.einsum("ij,ij->i", x[s] - pl.center[p], pl.normal[p])
-        return Candidates(lo, hi, i, j, s, p, np.where(signed < 0.0, -1.0, 1.0))
+        counts = (self._spheres.count, self._planes.count)
+        self._candidates = Candidates(lo, hi, i, j, s, p, np.where(signed < 0.0, -1.0, 1.0), counts)
+        return self._candidates
 
     def _escapes_boxes(self, candidates: Candidates, accel: np.ndarray, h: float) -> bool:
         """True when some ball's path for the next ``h`` leaves the box it was paired from."""
@@ -462,11 +491,12 @@ class World:
         self,
         c: ContactSet,
         batch: ContactBatch,
-        forces: list[ForceTerm],
+        lin: np.ndarray,
+        ang: np.ndarray,
         h: float,
         events: EventLog,
         now: float,
-    ) -> ConstantPerBall:
+    ) -> ConstantPerBall | None:
         """Constant contact forces over the next ``h`` seconds that leave every touching contact
         not approaching, not slipping beyond the friction cone, at the end of the interval.
 
@@ -475,8 +505,7 @@ class World:
         """
         n = self._spheres.count
         if len(c) == 0:
-            return ConstantPerBall(0.0, 0.0)
-        lin, ang = self._free_acceleration(forces)
+            return None
         v, w = self._velocities()
         v[:-1] += lin * h
         w[:-1] += ang * h

@@ -1,0 +1,1 @@
+"""Bundled scene files (TOML), shipped inside the wheel as package data."""

@@ -1,0 +1,1 @@
+"""GLSL sources for the viewer, shipped inside the wheel as package data."""

@@ -1,0 +1,250 @@
+"""Step-rate benchmarks: free flight, and a falling grid of balls piling into a box.
+
+Every measurement runs in its own process (``python -m ballpit.bench --one ...``) so engines and sizes
+do not share caches or memory, and so the peak resident memory per ball can be read honestly.
+PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile for comparison.
+
+    ballpit bench                       # free flight and pile tables at the default sizes
+    ballpit bench --workload pile --sizes 1000,10000 --pybullet --plot scaling.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import json
+import platform
+import resource
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+DT = 1 / 240
+RADIUS = 0.05
+SPACING = 0.11
+
+
+@dataclass
+class Result:
+    engine: str
+    workload: str
+    n: int
+    steps: int
+    seconds: float
+    rss_bytes_per_ball: float
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.seconds
+
+    @property
+    def ns_per_ball_step(self) -> float:
+        return 1e9 * self.seconds / (self.steps * self.n)
+
+
+def pile_layout(n: int, seed: int = 1) -> tuple[np.ndarray, float]:
+    """``n`` ball centres on a grid 0.11 m apart above a floor at y = 0, and the box's half width."""
+    side = int(np.ceil(np.sqrt(n / max(1, round(n ** (1 / 3))))))
+    layers = int(np.ceil(n / (side * side)))
+    ix, iy, iz = np.meshgrid(np.arange(side), np.arange(layers), np.arange(side), indexing="ij")
+    cells = np.stack((ix.ravel(), iy.ravel(), iz.ravel()), axis=1)
+    cells = cells[np.lexsort((cells[:, 2], cells[:, 0], cells[:, 1]))][:n]  # fill bottom layers first
+    half = 0.5 * side * SPACING + RADIUS
+    jitter = np.random.default_rng(seed).uniform(-0.002, 0.002, (n, 3))
+    centres = (cells - [0.5 * (side - 1), 0.0, 0.5 * (side - 1)]) * SPACING + [0.0, 2 * RADIUS, 0.0] + jitter
+    return centres, half
+
+
+def _ballpit_world(workload: str, n: int):
+    import ballpit
+
+    world = ballpit.World(integrator="rk4")
+    if workload == "free":
+        rng = np.random.default_rng(0)
+        side = int(np.ceil(n ** (1 / 3)))
+        grid = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n]
+        world.add_spheres(grid * 1.0, radius=RADIUS, velocity=rng.normal(0, 0.1, (n, 3)))
+        world.gravity = (0, 0, 0)
+        return world
+    centres, half = pile_layout(n)
+    world.add_plane(normal=(0, 1, 0), restitution=0.5, friction=0.5, rolling_friction=0.02)
+    for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
+        world.add_plane(position=np.multiply(normal, -half), normal=normal, restitution=0.5)
+    world.add_spheres(centres, radius=RADIUS, restitution=0.5, rolling_friction=0.02)
+    return world
+
+
+def _pybullet_world(workload: str, n: int):
+    import pybullet as p
+
+    client = p.connect(p.DIRECT)
+    p.setTimeStep(DT, physicsClientId=client)
+    p.setGravity(0, -9.81 if workload == "pile" else 0.0, 0, physicsClientId=client)
+    sphere = p.createCollisionShape(p.GEOM_SPHERE, radius=RADIUS, physicsClientId=client)
+    if workload == "free":
+        side = int(np.ceil(n ** (1 / 3)))
+        centres = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n] * 1.0
+    else:
+        centres, half = pile_layout(n)
+        # y is up here too: the floor's normal is +y, walls are thin boxes.
+        floor = p.createCollisionShape(p.GEOM_PLANE, planeNormal=[0, 1, 0], physicsClientId=client)
+        p.createMultiBody(0, floor, physicsClientId=client)
+        wall_x = p.createCollisionShape(
+            p.GEOM_BOX, halfExtents=[0.05, 1.0, half + 0.1], physicsClientId=client
+        )
+        wall_z = p.createCollisionShape(
+            p.GEOM_BOX, halfExtents=[half + 0.1, 1.0, 0.05], physicsClientId=client
+        )
+        for shape, pos in (
+            (wall_x, [-half - 0.05, 1.0, 0]),
+            (wall_x, [half + 0.05, 1.0, 0]),
+            (wall_z, [0, 1.0, -half - 0.05]),
+            (wall_z, [0, 1.0, half + 0.05]),
+        ):
+            p.createMultiBody(0, shape, basePosition=pos, physicsClientId=client)
+    for c in centres:
+        body = p.createMultiBody(1.0, sphere, basePosition=c.tolist(), physicsClientId=client)
+        p.changeDynamics(body, -1, restitution=0.5, lateralFriction=0.5, physicsClientId=client)
+    return lambda: p.stepSimulation(physicsClientId=client)
+
+
+def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
+    """Build the workload, step it ``steps`` times and time only the stepping."""
+    base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    if engine == "ballpit":
+        world = _ballpit_world(workload, n)
+        world.step(DT)  # first step outside the timing: imports and first allocations
+
+        def step() -> object:
+            return world.step(DT)
+    else:
+        step = _pybullet_world(workload, n)
+        step()
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    seconds = time.perf_counter() - start
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+    return Result(engine, workload, n, steps, seconds, (peak - base) * 1024.0 / n)
+
+
+def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float) -> Result | None:
+    """``measure_one`` in a fresh interpreter; None when it fails or runs out of time."""
+    cmd = [sys.executable, "-m", "ballpit.bench", "--one", engine, workload, str(n), str(steps)]
+    try:
+        out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=True).stdout
+    except (subprocess.CalledProcessError, subprocess.TimeoutExpired) as exc:
+        print(f"  {engine} {workload} N={n}: failed ({type(exc).__name__})", file=sys.stderr)
+        return None
+    return Result(**json.loads(out.strip().splitlines()[-1]))
+
+
+def _table(results: list[Result], reference: dict[tuple[str, int], Result]) -> str:
+    lines = [
+        f"{'engine':8} {'workload':8} {'N':>7} {'steps':>6} {'steps/s':>10} {'ns/ball-step':>13} "
+        f"{'RSS B/ball':>10} {'vs PyBullet':>11}"
+    ]
+    for r in results:
+        ref = reference.get((r.workload, r.n))
+        ratio = f"{r.steps_per_second / ref.steps_per_second:10.2f}x" if ref and r.engine == "ballpit" else ""
+        lines.append(
+            f"{r.engine:8} {r.workload:8} {r.n:7d} {r.steps:6d} {r.steps_per_second:10.1f} "
+            f"{r.ns_per_ball_step:13.1f} {r.rss_bytes_per_ball:10.0f} {ratio:>11}"
+        )
+    return "\n".join(lines)
+
+
+def _plot(results: list[Result], path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for engine in sorted({r.engine for r in results}):
+        for workload in sorted({r.workload for r in results}):
+            rs = sorted(
+                (r for r in results if r.engine == engine and r.workload == workload), key=lambda r: r.n
+            )
+            if rs:
+                ax.loglog(
+                    [r.n for r in rs],
+                    [1e3 / r.steps_per_second for r in rs],
+                    "o-",
+                    label=f"{engine} {workload}",
+                )
+    ax.set_xlabel("balls")
+    ax.set_ylabel("ms per step")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print(f"wrote {path}")
+
+
+def _sizes(text: str) -> list[int]:
+    try:
+        sizes = [int(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"sizes must be integers separated by commas, got {text!r}"
+        ) from None
+    if not sizes or min(sizes) < 1:
+        raise argparse.ArgumentTypeError(f"sizes must be positive, got {text!r}")
+    return sizes
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="ballpit bench", description=__doc__.splitlines()[0])
+    parser.add_argument("--workload", choices=("free", "pile", "all"), default="all")
+    parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
+    parser.add_argument("--steps", type=int, default=None, help="steps to time (default: 1 s of simulation)")
+    parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
+    parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
+    parser.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per measurement")
+    parser.add_argument(
+        "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
+    )
+    args = parser.parse_args(argv)
+
+    if args.one:
+        engine, workload, n, steps = args.one
+        print(json.dumps(asdict(measure_one(engine, workload, int(n), int(steps)))))
+        return 0
+    if args.pybullet and importlib.util.find_spec("pybullet") is None:
+        print("ballpit bench: --pybullet needs PyBullet: pip install 'ballpit[bench]'", file=sys.stderr)
+        return 2
+
+    plan = []
+    if args.workload in ("free", "all"):
+        plan += [("free", n) for n in (args.sizes or [10, 100, 1_000, 10_000, 100_000])]
+    if args.workload in ("pile", "all"):
+        plan += [("pile", n) for n in (args.sizes or [1_000, 10_000])]
+    machine = platform.processor() or platform.machine()
+    versions = f"Python {platform.python_version()}, NumPy {np.__version__}"
+    print(f"ballpit bench: {machine}, {versions}, dt = 1/240 s, RK4, each row in its own process")
+    results: list[Result] = []
+    reference: dict[tuple[str, int], Result] = {}
+    for workload, n in plan:
+        steps = args.steps or 240  # one simulated second
+        engines = ["ballpit"] + (["pybullet"] if args.pybullet else [])
+        for engine in engines:
+            r = run_isolated(engine, workload, n, steps, args.timeout)
+            if r is None:
+                continue
+            results.append(r)
+            if engine == "pybullet":
+                reference[(workload, n)] = r
+            print(_table([r], {}).splitlines()[1], flush=True)
+    print()
+    print(_table(results, reference))
+    if args.plot:
+        _plot(results, args.plot)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
