@@ -829,17 +829,7 @@ class _Builder:
         raise IndexError(k)
 
 
-BALL_COLUMNS = (
-    "radius",
-    "mass",
-    "velocity",
-    "angular_velocity",
-    "orientation",
-    "restitution",
-    "friction",
-    "rolling_friction",
-    "hollow",
-)
+BALL_COLUMNS = tuple(k for k in BALL_KEYS if k != "color")  # the keys that become World columns
 
 
 def first_overlap(positions: np.ndarray, radii: np.ndarray, tolerance: float = 0.0) -> tuple[int, int] | None:
