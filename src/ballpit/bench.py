@@ -6,6 +6,7 @@ PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile 
 
     ballpit bench                       # free flight and pile tables at the default sizes
     ballpit bench --workload pile --sizes 1000,10000 --pybullet --plot scaling.png
+    ballpit bench --workload settled --sizes 1000,10000,100000   # cost growth in a pile at rest
 """
 
 from __future__ import annotations
@@ -58,6 +59,17 @@ def pile_layout(n: int, seed: int = 1) -> tuple[np.ndarray, float]:
     return centres, half
 
 
+def settled_layout(n: int) -> tuple[np.ndarray, float]:
+    """``n`` balls at rest in touching columns on the floor (a pile after settling), and the half width."""
+    layers = max(1, round(n ** (1 / 3)))
+    side = int(np.ceil(np.sqrt(n / layers)))
+    ix, iy, iz = np.meshgrid(np.arange(side), np.arange(layers + 1), np.arange(side), indexing="ij")
+    cells = np.stack((ix.ravel(), iy.ravel(), iz.ravel()), axis=1)
+    cells = cells[np.lexsort((cells[:, 2], cells[:, 0], cells[:, 1]))][:n]
+    centres = (cells - [0.5 * (side - 1), 0.0, 0.5 * (side - 1)]) * (2 * RADIUS) + [0.0, RADIUS, 0.0]
+    return centres, side * RADIUS
+
+
 def _ballpit_world(workload: str, n: int):
     import ballpit
 
@@ -69,7 +81,7 @@ def _ballpit_world(workload: str, n: int):
         world.add_spheres(grid * 1.0, radius=RADIUS, velocity=rng.normal(0, 0.1, (n, 3)))
         world.gravity = (0, 0, 0)
         return world
-    centres, half = pile_layout(n)
+    centres, half = pile_layout(n) if workload == "pile" else settled_layout(n)
     world.add_plane(normal=(0, 1, 0), restitution=0.5, friction=0.5, rolling_friction=0.02)
     for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
         world.add_plane(position=np.multiply(normal, -half), normal=normal, restitution=0.5)
@@ -82,13 +94,13 @@ def _pybullet_world(workload: str, n: int):
 
     client = p.connect(p.DIRECT)
     p.setTimeStep(DT, physicsClientId=client)
-    p.setGravity(0, -9.81 if workload == "pile" else 0.0, 0, physicsClientId=client)
+    p.setGravity(0, 0.0 if workload == "free" else -9.81, 0, physicsClientId=client)
     sphere = p.createCollisionShape(p.GEOM_SPHERE, radius=RADIUS, physicsClientId=client)
     if workload == "free":
         side = int(np.ceil(n ** (1 / 3)))
         centres = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n] * 1.0
     else:
-        centres, half = pile_layout(n)
+        centres, half = pile_layout(n) if workload == "pile" else settled_layout(n)
         # y is up here too: the floor's normal is +y, walls are thin boxes.
         floor = p.createCollisionShape(p.GEOM_PLANE, planeNormal=[0, 1, 0], physicsClientId=client)
         p.createMultiBody(0, floor, physicsClientId=client)
@@ -199,7 +211,12 @@ def _sizes(text: str) -> list[int]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="ballpit bench", description=__doc__.splitlines()[0])
-    parser.add_argument("--workload", choices=("free", "pile", "all"), default="all")
+    parser.add_argument(
+        "--workload",
+        choices=("free", "pile", "settled", "all"),
+        default="all",
+        help="free flight; a grid falling into a box (the pile forming); or a pile already at rest",
+    )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument("--steps", type=int, default=None, help="steps to time (default: 1 s of simulation)")
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
@@ -223,6 +240,8 @@ def main(argv: list[str] | None = None) -> int:
         plan += [("free", n) for n in (args.sizes or [10, 100, 1_000, 10_000, 100_000])]
     if args.workload in ("pile", "all"):
         plan += [("pile", n) for n in (args.sizes or [1_000, 10_000])]
+    if args.workload in ("settled", "all"):
+        plan += [("settled", n) for n in (args.sizes or [1_000, 10_000, 100_000])]
     machine = platform.processor() or platform.machine()
     versions = f"Python {platform.python_version()}, NumPy {np.__version__}"
     print(f"ballpit bench: {machine}, {versions}, dt = 1/240 s, RK4, each row in its own process")
@@ -241,6 +260,15 @@ def main(argv: list[str] | None = None) -> int:
             print(_table([r], {}).splitlines()[1], flush=True)
     print()
     print(_table(results, reference))
+    for engine in ("ballpit", "pybullet"):
+        settled = sorted(
+            (r for r in results if r.engine == engine and r.workload == "settled"), key=lambda r: r.n
+        )
+        if len(settled) >= 2:
+            slope = np.polyfit(
+                np.log([r.n for r in settled]), np.log([1 / r.steps_per_second for r in settled]), 1
+            )[0]
+            print(f"{engine}: log-log slope of step time against N in the settled pile: {slope:.2f}")
     if args.plot:
         _plot(results, args.plot)
     return 0

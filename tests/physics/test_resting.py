@@ -24,7 +24,7 @@ def test_a_few_hundred_balls_settle_into_a_still_pile():
     grid = np.stack(np.meshgrid(np.arange(5), np.arange(8), np.arange(5), indexing="ij"), -1).reshape(-1, 3)
     positions = grid * 0.11 + [-0.22, 0.3, -0.22] + rng.uniform(-0.004, 0.004, grid.shape)
     world.add_spheres(positions, radius=r, restitution=0.5, rolling_friction=0.05)
-    for _ in range(240 * 3):
+    for _ in range(240 * 5):
         world.step(1 / 240)
     speeds = np.linalg.norm(world.spheres.velocities, axis=1)
     assert speeds.max() < 1e-3

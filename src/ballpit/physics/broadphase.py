@@ -24,14 +24,6 @@ _OFFSETS = np.array(
 )
 
 
-def swept_boxes(
-    start: np.ndarray, end: np.ndarray, radius: np.ndarray, margin: np.ndarray | float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Boxes around each ball's path from ``start`` to ``end``, grown by its radius and a margin."""
-    pad = (radius + margin)[:, None]
-    return np.minimum(start, end) - pad, np.maximum(start, end) + pad
-
-
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each k, the integers starts[k] … starts[k]+counts[k]−1, flattened, with their owner k."""
     total = int(counts.sum())

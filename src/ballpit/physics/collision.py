@@ -62,12 +62,14 @@ def sphere_sphere(
     x: np.ndarray, radius: np.ndarray, i: np.ndarray, j: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap, unit normal (from j towards i) and contact point (middle of the gap) for each pair."""
-    delta = x[i] - x[j]
+    xj = x[j]
+    delta = x[i] - xj
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
-    # Coincident centres have no normal; pick +y so the pair separates vertically.
-    normal = np.where(
-        (dist > 1e-12)[:, None], delta / np.where(dist > 1e-12, dist, 1.0)[:, None], [0.0, 1.0, 0.0]
-    )
-    gap = dist - radius[i] - radius[j]
-    point = x[j] + normal * (radius[j] + 0.5 * gap)[:, None]
+    coincident = dist <= 1e-12
+    normal = delta / np.maximum(dist, 1e-12)[:, None]
+    if coincident.any():  # coincident centres have no normal; pick +y so the pair separates vertically
+        normal[coincident] = (0.0, 1.0, 0.0)
+    rj = radius[j]
+    gap = dist - radius[i] - rj
+    point = xj + normal * (rj + 0.5 * gap)[:, None]
     return gap, normal, point

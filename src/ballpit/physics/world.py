@@ -18,6 +18,8 @@ HOLLOW_INERTIA = 2.0 / 3.0
 
 # Balls closer than this (m) are in contact: the solver holds them, time of impact stops here.
 CONTACT_SLOP = 1e-5
+# Overlaps shallower than this (m) are left alone: rounding, not penetration.
+OVERLAP_TOLERANCE = 1e-7
 # Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
 APPROACH_SPEED = 1e-6
 # Impacts whose times are this close (as an overlap, in radii) are resolved together: a pile of 1,000
@@ -25,8 +27,11 @@ APPROACH_SPEED = 1e-6
 IMPACT_OVERLAP = 0.005
 # Broad-phase boxes cover this many steps of each ball's path, so most steps reuse the pairs.
 BROAD_PHASE_STEPS = 4
+# … or as far as a ball travels this fraction of its radius, if that is sooner (but never less than
+# the step itself) …
+BROAD_PHASE_REACH = 0.2
 # … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
-BROAD_PHASE_MARGIN = 0.25
+BROAD_PHASE_MARGIN = 0.1
 # A step is split at most this many times; past it the rest of the step is taken whole.
 MAX_INTERVALS = 10_000
 # Explicit Euler's default restitution threshold, in units of |g|·dt (see _bounce_threshold).
@@ -297,7 +302,8 @@ class World:
             if push is not None:
                 lin += push.lin
             if self._escapes_boxes(candidates, lin, remaining):
-                candidates = self._broad_phase(remaining + (BROAD_PHASE_STEPS - 1) * dt, lin)
+                ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
+                candidates = self._broad_phase(remaining, ahead, lin, self._free_acceleration(forces)[0])
                 contacts = self._narrow_phase(candidates)
             intervals += 1
             if intervals < MAX_INTERVALS:
@@ -340,7 +346,7 @@ class World:
         c = self._candidates
         counts = (self._spheres.count, self._planes.count)
         if c is None or c.counts != counts or self._escapes_boxes(c, accel, dt):
-            c = self._candidates = self._broad_phase(BROAD_PHASE_STEPS * dt, accel)
+            c = self._candidates = self._broad_phase(dt, BROAD_PHASE_STEPS * dt, accel, accel)
         elif len(c.sphere):
             pl = self._planes
             signed = np.einsum(
@@ -349,12 +355,26 @@ class World:
             c.side = np.where(signed < 0.0, -1.0, 1.0)
         return c
 
-    def _broad_phase(self, h: float, accel: np.ndarray) -> Candidates:
-        """Candidate pairs for the next ``h`` seconds, from boxes around each ball's swept path."""
+    def _broad_phase(self, h: float, ahead: float, accel: np.ndarray, free: np.ndarray) -> Candidates:
+        """Candidate pairs from boxes around each ball's swept path.
+
+        Each box covers the next ``h`` seconds under ``accel`` (contact forces included), and beyond it
+        up to ``ahead`` seconds of free flight under ``free`` for balls slow enough to travel less than
+        BROAD_PHASE_REACH radii in that time: slow balls keep their pairs for several steps while fast
+        ones do not drag big boxes through a crowd.
+        """
         state, radius = self._spheres.state, self._spheres.radius
         x = state[:, X]
-        margin = np.linalg.norm(accel, axis=1) * h * h + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP
-        lo, hi = broadphase.swept_boxes(x, self._path_end(accel, h), radius, margin)
+        speed = np.linalg.norm(state[:, V], axis=1)
+        horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, 1e-12), h, max(h, ahead))
+        now, later = self._path_end(accel, h), x + state[:, V] * horizon[:, None]
+        if self._integrator.quadratic_path:
+            later += 0.5 * horizon[:, None] ** 2 * free
+        # a parabola strays at most ⅛·|a|·t² from its chord
+        sag = 0.125 * (np.linalg.norm(accel, axis=1) * h * h + np.linalg.norm(free, axis=1) * horizon**2)
+        pad = (radius + sag + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP)[:, None]
+        lo = np.minimum(np.minimum(x, now), later) - pad
+        hi = np.maximum(np.maximum(x, now), later) + pad
         i, j = broadphase.sphere_pairs(lo, hi)
         pl = self._planes
         s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
@@ -436,7 +456,7 @@ class World:
         A few Gauss–Seidel sweeps over the linearised gaps g = n·(x_a − x_b) − offset, each ball moved in
         proportion to its inverse mass.
         """
-        if not np.any(c.gap < 0.0):
+        if not np.any(c.gap < -OVERLAP_TOLERANCE):
             return
         x = self._spheres.state[:, X]
         pos = np.vstack((x, np.zeros(3)))
