@@ -1,6 +1,8 @@
 """World construction, views, planes and argument checking."""
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -166,3 +168,13 @@ def test_step_advances_time():
     world.step(0.25)
     world.step(0.25)
     assert world.time == pytest.approx(0.5)
+
+
+def test_the_physics_package_imports_no_window_or_gl_library():
+    code = (
+        "import sys, ballpit, ballpit.physics\n"
+        "w = ballpit.World(); w.add_plane(); w.add_sphere(position=(0, 1, 0)); w.step(0.01)\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('pyglet', 'OpenGL', 'pyrr')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"

@@ -277,9 +277,11 @@ class World:
     def step(self, dt: float) -> Contacts:
         """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
 
-        The step is split at every impact. Each interval runs the same stages: find the contacts,
-        push overlapping balls apart, bounce the ones that arrive, solve the resting contacts for
-        constant forces over the interval, predict the next impact, and integrate to it.
+        The broad phase's pairs come first (kept from earlier steps while they still cover every
+        ball's path). Then the step is split at every impact, and each interval runs the same stages:
+        find the contacts, push overlapping balls apart, bounce the ones that arrive, solve the
+        resting contacts for constant forces over the interval, predict the next impact, and
+        integrate to it.
         """
         dt = validation.number("dt", dt, positive=True)
         state = self._spheres.state
@@ -297,22 +299,20 @@ class World:
             self._remove_penetration(touching, batch)
             now = self.time + elapsed
             self._bounce(touching, batch, threshold, events, now)
-            lin, ang = self._free_acceleration(forces)
-            push = self._resting_forces(touching, batch, lin, ang, remaining, events, now)
-            if push is not None:
-                lin += push.lin
+            free, ang = self._free_acceleration(forces)
+            push = self._resting_forces(touching, batch, free, ang, remaining, events, now)
+            lin = free if push is None else free + push.lin
             if self._escapes_boxes(candidates, lin, remaining):
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
-                candidates = self._broad_phase(remaining, ahead, lin, self._free_acceleration(forces)[0])
+                candidates = self._broad_phase(remaining, ahead, lin, free)
                 contacts = self._narrow_phase(candidates)
             intervals += 1
             if intervals < MAX_INTERVALS:
                 h = min(self._next_impact(contacts, lin, remaining), remaining)
             else:  # a pathological pile-up: finish the step without splitting it further
                 h = remaining
-            integrate(
-                self._integrator, state, forces if push is None else [*forces, push], h, self._workspace
-            )
+            terms = forces if push is None else [*forces, push]
+            integrate(self._integrator, state, terms, h, self._workspace)
             events.close_interval(h / remaining)
             elapsed = dt if h >= remaining else elapsed + h
         self._reject_non_finite(before)
