@@ -178,3 +178,13 @@ def test_the_physics_package_imports_no_window_or_gl_library():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
+
+
+def test_a_nan_written_straight_into_the_arrays_is_refused_by_name_before_stepping():
+    world = ballpit.World()
+    world.add_sphere(position=(0, 1, 0))
+    world.add_sphere(position=(3, 1, 0))
+    world.spheres.velocities[1, 2] = float("nan")
+    with pytest.raises(ValueError, match=r"sphere #1 has a non-finite velocity"):
+        world.step(0.01)
+    assert world.time == 0.0

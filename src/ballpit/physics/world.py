@@ -285,6 +285,7 @@ class World:
         """
         dt = validation.number("dt", dt, positive=True)
         state = self._spheres.state
+        self._reject_non_finite_input()
         before = state.copy()
         forces = self.forces()
         threshold = self._bounce_threshold(dt)
@@ -628,6 +629,18 @@ class World:
         """Gravitational potential energy −Σ m·g·x (J), zero at the origin."""
         sph = self._spheres
         return float(-(sph.mass @ (sph.state[:, X] @ self._gravity)))
+
+    def _reject_non_finite_input(self) -> None:
+        """Refuse to step from a NaN/inf written straight into the arrays (the setters check theirs)."""
+        state = self._spheres.state
+        if np.isfinite(state).all():
+            return
+        row, col = np.argwhere(~np.isfinite(state))[0]
+        fields = (("position", X), ("velocity", V), ("orientation", Q), ("angular_velocity", W))
+        field = next(name for name, cols in fields if cols.start <= col < cols.stop)
+        raise ValueError(
+            f"sphere #{row} has a non-finite {field} ({state[row, col]}); the world was not stepped"
+        )
 
     def _reject_non_finite(self, before: np.ndarray) -> None:
         """Keep the world free of NaN/inf: restore the state and raise if a step produced any."""
