@@ -18,6 +18,8 @@ HOLLOW_INERTIA = 2.0 / 3.0
 
 # Balls closer than this (m) are in contact: the solver holds them, time of impact stops here.
 CONTACT_SLOP = 1e-5
+# The bounce is solved over the contacts within this many balls of an arriving one.
+BOUNCE_HOPS = 3
 # Overlaps shallower than this (m) are left alone: rounding, not penetration.
 OVERLAP_TOLERANCE = 1e-7
 # Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
@@ -491,11 +493,11 @@ class World:
         approaching = vn < -APPROACH_SPEED
         if not approaching.any():
             return
-        # The island around the impacts: contacts within two balls of an approaching one.
+        # The island around the impacts: contacts within BOUNCE_HOPS balls of an approaching one.
         n = self._spheres.count
         involved = np.zeros(n + 1, bool)
         near = approaching
-        for _ in range(3):
+        for _ in range(BOUNCE_HOPS):
             involved[c.a[near]] = True
             involved[c.b[near]] = True
             involved[n] = False
