@@ -90,9 +90,13 @@ def derivative(q: np.ndarray, omega: np.ndarray, out: np.ndarray) -> np.ndarray:
 
     With the pure quaternion (ω, 0) on the left: vector part ½(q_w·ω + ω × q_v), scalar −½ ω·q_v.
     """
-    half = 0.5 * omega
-    qv = q[:, :3]
-    np.multiply(q[:, 3:4], half, out=out[:, :3])
-    out[:, :3] += np.cross(half, qv)
-    out[:, 3] = -np.einsum("ij,ij->i", half, qv)
+    # Component by component: on the strided columns of the state block this is about twice as fast
+    # as a cross product, which would first copy them.
+    qx, qy, qz, qw = q.T
+    wx, wy, wz = omega.T
+    out[:, 0] = qw * wx + wy * qz - wz * qy
+    out[:, 1] = qw * wy + wz * qx - wx * qz
+    out[:, 2] = qw * wz + wx * qy - wy * qx
+    out[:, 3] = -(wx * qx + wy * qy + wz * qz)
+    out *= 0.5
     return out

@@ -292,7 +292,8 @@ class World:
         forces = self.forces()
         threshold = self._bounce_threshold(dt)
         events = EventLog()
-        candidates = self._candidate_pairs(dt, self._free_acceleration(forces)[0])
+        free, ang = self._free_acceleration(forces)
+        candidates = self._candidate_pairs(dt, free)
         elapsed, intervals = 0.0, 0
         while elapsed < dt:
             remaining = dt - elapsed
@@ -302,10 +303,12 @@ class World:
             self._remove_penetration(touching, batch)
             now = self.time + elapsed
             self._bounce(touching, batch, threshold, events, now)
-            free, ang = self._free_acceleration(forces)
+            if intervals or len(touching):  # velocities may have changed since the step began
+                free, ang = self._free_acceleration(forces)
             push = self._resting_forces(touching, batch, free, ang, remaining, events, now)
             lin = free if push is None else free + push.lin
-            if self._escapes_boxes(candidates, lin, remaining):
+            # The first interval's free path was checked against the boxes when the pairs were taken.
+            if (intervals or push is not None) and self._escapes_boxes(candidates, lin, remaining):
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
                 candidates = self._broad_phase(remaining, ahead, lin, free)
                 contacts = self._narrow_phase(candidates)
