@@ -72,19 +72,6 @@ def from_up_to(normal: np.ndarray) -> np.ndarray:
     return normalize(np.concatenate((np.cross(up, n), [1.0 + d])))
 
 
-def to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) from unit quaternions."""
-    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
-    return np.stack(
-        (
-            np.stack((1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)), axis=-1),
-            np.stack((2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)), axis=-1),
-            np.stack((2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)), axis=-1),
-        ),
-        axis=-2,
-    )
-
-
 def derivative(q: np.ndarray, omega: np.ndarray, out: np.ndarray) -> np.ndarray:
     """dq/dt = ½·(ω, 0) ⊗ q for a world-frame angular velocity ω, written into ``out`` (N, 4).
 

@@ -67,9 +67,6 @@ class Impulses:
     def zeros(count: int) -> Impulses:
         return Impulses(np.zeros(count), np.zeros((count, 3)), np.zeros((count, 3)))
 
-    def scaled(self, factor: float) -> Impulses:
-        return Impulses(self.normal * factor, self.friction * factor, self.rolling * factor)
-
 
 def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
     """Split contacts into groups in which no ball appears twice (the static row may repeat).
