@@ -353,13 +353,15 @@ class World:
         counts = (self._spheres.count, self._planes.count)
         if c is None or c.counts != counts or self._escapes_boxes(c, accel, dt):
             c = self._candidates = self._broad_phase(dt, BROAD_PHASE_STEPS * dt, accel, accel)
-        elif len(c.sphere):
-            pl = self._planes
-            signed = np.einsum(
-                "ij,ij->i", self._spheres.state[c.sphere, 0:3] - pl.center[c.plane], pl.normal[c.plane]
-            )
-            c.side = np.where(signed < 0.0, -1.0, 1.0)
+        else:
+            c.side = self._plane_sides(c.sphere, c.plane)
         return c
+
+    def _plane_sides(self, sphere: np.ndarray, plane: np.ndarray) -> np.ndarray:
+        """±1: which side of each plane each ball's centre is on (+1 on the normal's side or in it)."""
+        pl = self._planes
+        signed = np.einsum("ij,ij->i", self._spheres.state[sphere, 0:3] - pl.center[plane], pl.normal[plane])
+        return np.where(signed < 0.0, -1.0, 1.0)
 
     def _broad_phase(self, h: float, ahead: float, accel: np.ndarray, free: np.ndarray) -> Candidates:
         """Candidate pairs from boxes around each ball's swept path.
@@ -384,9 +386,8 @@ class World:
         i, j = broadphase.sphere_pairs(lo, hi)
         pl = self._planes
         s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
-        signed = np.einsum("ij,ij->i", x[s] - pl.center[p], pl.normal[p])
         counts = (self._spheres.count, self._planes.count)
-        self._candidates = Candidates(lo, hi, i, j, s, p, np.where(signed < 0.0, -1.0, 1.0), counts)
+        self._candidates = Candidates(lo, hi, i, j, s, p, self._plane_sides(s, p), counts)
         return self._candidates
 
     def _escapes_boxes(self, candidates: Candidates, accel: np.ndarray, h: float) -> bool:
@@ -484,8 +485,8 @@ class World:
     ) -> None:
         """Impacts: contacts arriving faster than the threshold leave at e times their approach speed.
 
-        All touching contacts take part, so a ball landing on a stack pushes through it; contacts
-        arriving slower than the threshold just stop.
+        The touching contacts within BOUNCE_HOPS balls of an arriving one take part, so a ball landing
+        on a stack pushes through it; contacts arriving slower than the threshold just stop.
         """
         if len(c) == 0:
             return
@@ -511,7 +512,8 @@ class World:
         state = self._spheres.state
         state[:, V] = v[:-1]
         state[:, W] = w[:-1]
-        events.add(now, c.subset(near), c.subset(near).keys(n), imp.normal)
+        hit = c.subset(near)
+        events.add(now, hit, hit.keys(n), imp.normal)
 
     def _resting_forces(
         self,
