@@ -66,6 +66,8 @@ class Candidates:
 
     lo: np.ndarray  # (N, 3) swept boxes
     hi: np.ndarray
+    centre: np.ndarray  # (N, 3) and (N,): a sphere around each ball's swept path, tighter than its box
+    reach: np.ndarray
     pair_i: np.ndarray  # sphere–sphere pairs, i < j
     pair_j: np.ndarray
     sphere: np.ndarray  # sphere–plane pairs

@@ -96,12 +96,8 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
 
 def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """Scale each row down to length ≤ limit (the friction cone and the rolling-resistance limit)."""
-    length2 = np.einsum("ij,ij->i", vectors, vectors)
-    over = length2 > limit * limit
-    if not over.any():
-        return vectors
-    scale = np.where(over, limit / np.sqrt(np.where(over, length2, 1.0)), 1.0)
-    return vectors * scale[:, None]
+    length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors) + 1e-300)  # + tiny: no 0/0 at zero
+    return vectors * np.minimum(limit / length, 1.0)[:, None]
 
 
 def skew(n: np.ndarray) -> np.ndarray:
@@ -114,32 +110,42 @@ def skew(n: np.ndarray) -> np.ndarray:
 
 
 class _Colour:
-    """One colour's contacts, gathered once per solve so the iterations only touch velocities.
+    """One colour's contacts, gathered once per solve so the sweeps only touch velocities.
+
+    Velocities are rows of one (M, 6) array [v | ω] holding just the balls the solve touches; a
+    colour gathers rows ``a`` then ``b`` as one (2, k, 6) block and writes it back in one go.
 
     With arms r_a = −ρ_a·n and r_b = +ρ_b·n (ρ the radii), the contact-point velocity is
     v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n, and a tangential impulse P turns the balls by
     Δω_a = −ρ_a·I_a⁻¹·(n × P), Δω_b = −ρ_b·I_b⁻¹·(n × P).
     """
 
-    def __init__(self, batch: ContactBatch, idx: np.ndarray) -> None:
+    def __init__(self, batch: ContactBatch, idx: np.ndarray, local: np.ndarray) -> None:
+        k = len(idx)
         self.idx = idx
-        self.a, self.b = batch.a[idx], batch.b[idx]
+        self.rows = local[np.concatenate((idx, idx + len(batch)))]
         self.n = batch.normal[idx]
         self.nx = skew(self.n)
         ra = np.sqrt(np.einsum("ij,ij->i", batch.arm_a[idx], batch.arm_a[idx]))
         rb = np.sqrt(np.einsum("ij,ij->i", batch.arm_b[idx], batch.arm_b[idx]))
         self.ra, self.rb = ra[:, None], rb[:, None]
-        self.ima, self.imb = batch.inv_mass_a[idx, None], batch.inv_mass_b[idx, None]
-        self.iia, self.iib = batch.inv_inertia_a[idx, None], batch.inv_inertia_b[idx, None]
-        self.turn_a, self.turn_b = self.ra * self.iia, self.rb * self.iib
-        self.inv_m_n = batch.inv_mass_a[idx] + batch.inv_mass_b[idx]
-        self.m_n = 1.0 / self.inv_m_n
-        self.m_t = 1.0 / (self.ima + ra[:, None] ** 2 * self.iia + self.imb + rb[:, None] ** 2 * self.iib)
-        self.m_r = 1.0 / np.maximum(self.iia + self.iib, 1e-300)
+        ima, imb = batch.inv_mass_a[idx], batch.inv_mass_b[idx]
+        iia, iib = batch.inv_inertia_a[idx], batch.inv_inertia_b[idx]
+        self.m_n = 1.0 / (ima + imb)
+        inv_m_t = ima + ra**2 * iia + imb + rb**2 * iib
+        self.m_t = (1.0 / inv_m_t)[:, None]
+        self.m_r = (1.0 / np.maximum(iia + iib, 1e-300))[:, None]
+        # Coefficients of the update, stacked for a then b: Δv = ±m⁻¹·P, Δω = −ρ·I⁻¹·(n × P_t) ± I⁻¹·R.
+        self.lin = np.stack((ima, -imb)).reshape(2, k, 1)
+        self.turn = -np.stack((ra * iia, rb * iib)).reshape(2, k, 1)
+        self.roll = np.stack((iia, -iib)).reshape(2, k, 1)
+        # Bounds on how much a unit of impulse changes a contact's velocity, for the convergence test.
+        self.max_inv_m_n = float((ima + imb).max())
+        self.max_inv_m_t = float(inv_m_t.max())
         self.mu = batch.friction[idx]
-        self.roll = batch.rolling[idx]
+        self.rolling = batch.rolling[idx]
         self.has_friction = bool(self.mu.any())
-        self.has_rolling = bool(self.roll.any())
+        self.has_rolling = bool(self.rolling.any())
 
 
 def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -177,58 +183,59 @@ def solve(
     rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates."""
     if len(batch) == 0:
         return imp
-    colours = [_Colour(batch, idx) for idx in batch.colours]
+    # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
+    # the island does, not what the world does.
+    balls, local = np.unique(np.concatenate((batch.a, batch.b)), return_inverse=True)
+    vw = np.hstack((v[balls], w[balls]))
+    colours = [_Colour(batch, idx, local) for idx in batch.colours]
     targets = [target[c.idx] for c in colours]
     normal = [imp.normal[c.idx] for c in colours]
     friction = [imp.friction[c.idx] for c in colours]
     rolling = [imp.rolling[c.idx] for c in colours]
     for _ in range(iterations):
-        change = 0.0  # the largest velocity change this sweep made at any contact (m/s)
+        change = 0.0  # a bound on the largest velocity change this sweep made at any contact (m/s)
         for k, c in enumerate(colours):
-            va, vb, wa, wb = v[c.a], v[c.b], w[c.a], w[c.b]
+            g = vw[c.rows].reshape(2, -1, 6)
+            (va, wa), (vb, wb) = (g[0, :, :3], g[0, :, 3:]), (g[1, :, :3], g[1, :, 3:])
             # contact-point velocity of a relative to b: v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n
-            spin = c.ra * wa + c.rb * wb
-            rel = va - vb + np.einsum("kij,kj->ki", c.nx, spin)
+            rel = va - vb + np.einsum("kij,kj->ki", c.nx, c.ra * wa + c.rb * wb)
             vn = np.einsum("ij,ij->i", rel, c.n)
 
             # normal: the accumulated impulse stays ≥ 0
             old = normal[k]
             new = np.maximum(old + c.m_n * (targets[k] - vn), 0.0)
             normal[k] = new
-            linear = (new - old)[:, None] * c.n
-            change = max(change, float(np.max(np.abs(new - old) * c.inv_m_n)))
+            d_n = new - old
+            linear = d_n[:, None] * c.n
+            change = max(change, float(np.abs(d_n).max()) * c.max_inv_m_n)
 
             if c.has_friction:
                 # friction: cancel slip (the tangential part of rel, which the normal impulse leaves
                 # alone), inside the Coulomb cone |P_t| ≤ μ·P_n
-                slip = rel - vn[:, None] * c.n
                 old_t = friction[k]
-                new_t = _cap(old_t - c.m_t * slip, c.mu * new)
+                new_t = _cap(old_t - c.m_t * (rel - vn[:, None] * c.n), c.mu * new)
                 friction[k] = new_t
                 d_t = new_t - old_t
-                turn = np.einsum("kij,kj->ki", c.nx, d_t)  # n × ΔP_t
-                wa = wa - c.turn_a * turn
-                wb = wb - c.turn_b * turn
                 linear += d_t
-                change = max(change, float(np.max(np.abs(d_t) / c.m_t)))
+                turn = np.einsum("kij,kj->ki", c.nx, d_t)  # n × ΔP_t
+                g[:, :, 3:] += c.turn * turn
+                change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t)
 
             if c.has_rolling:
-                # rolling resistance: oppose relative spin, up to ρ·r·P_n
+                # rolling resistance: oppose relative spin (after the friction turn), up to ρ·r·P_n
                 old_r = rolling[k]
-                new_r = _cap(old_r - c.m_r * (wa - wb), c.roll * new)
+                new_r = _cap(old_r - c.m_r * (wa - wb), c.rolling * new)
                 rolling[k] = new_r
-                d_r = new_r - old_r
-                wa = wa + c.iia * d_r
-                wb = wb - c.iib * d_r
+                g[:, :, 3:] += c.roll * (new_r - old_r)
 
-            v[c.a] = va + c.ima * linear
-            v[c.b] = vb - c.imb * linear
-            w[c.a] = wa
-            w[c.b] = wb
-        v[-1] = 0.0
-        w[-1] = 0.0
+            g[:, :, :3] += c.lin * linear
+            vw[c.rows] = g.reshape(-1, 6)
         if change < CONVERGED:
             break
+    v[balls] = vw[:, :3]
+    w[balls] = vw[:, 3:]
+    v[-1] = 0.0
+    w[-1] = 0.0
     for k, c in enumerate(colours):
         imp.normal[c.idx] = normal[k]
         imp.friction[c.idx] = friction[k]

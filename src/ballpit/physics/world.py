@@ -381,26 +381,32 @@ class World:
         # a parabola strays at most ⅛·|a|·t² from its chord
         sag = 0.125 * (np.linalg.norm(accel, axis=1) * h * h + np.linalg.norm(free, axis=1) * horizon**2)
         pad = (radius + sag + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP)[:, None]
-        lo = np.minimum(np.minimum(x, now), later) - pad
-        hi = np.maximum(np.maximum(x, now), later) + pad
-        i, j = broadphase.sphere_pairs(lo, hi)
+        lo = np.minimum(np.minimum(x, now), later)
+        hi = np.maximum(np.maximum(x, now), later)
+        centre = 0.5 * (lo + hi)
+        reach = 0.5 * np.linalg.norm(hi - lo, axis=1) + pad[:, 0]
+        lo -= pad
+        hi += pad
+        i, j = broadphase.within_reach(*broadphase.sphere_pairs(lo, hi), centre, reach)
         pl = self._planes
         s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
         counts = (self._spheres.count, self._planes.count)
-        self._candidates = Candidates(lo, hi, i, j, s, p, self._plane_sides(s, p), counts)
+        self._candidates = Candidates(lo, hi, centre, reach, i, j, s, p, self._plane_sides(s, p), counts)
         return self._candidates
 
     def _escapes_boxes(self, candidates: Candidates, accel: np.ndarray, h: float) -> bool:
-        """True when some ball's path for the next ``h`` leaves the box it was paired from."""
+        """True when some ball's path for the next ``h`` leaves the box or sphere it was paired from."""
         x, radius = self._spheres.state[:, X], self._spheres.radius
         end = self._path_end(accel, h)
         # a parabola strays at most ⅛·|a|·h² from the chord between its ends
         sag = 0.125 * h * h * np.linalg.norm(accel, axis=1) if self._integrator.quadratic_path else 0.0
-        pad = (radius + sag)[:, None]
-        return bool(
-            np.any(np.minimum(x, end) - pad < candidates.lo)
-            or np.any(np.maximum(x, end) + pad > candidates.hi)
-        )
+        pad = radius + sag
+        c, box_pad = candidates, pad[:, None]
+        if np.any(np.minimum(x, end) - box_pad < c.lo) or np.any(np.maximum(x, end) + box_pad > c.hi):
+            return True
+        # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
+        farthest = np.maximum(np.linalg.norm(x - c.centre, axis=1), np.linalg.norm(end - c.centre, axis=1))
+        return bool(np.any(farthest + pad > c.reach))
 
     def _narrow_phase(self, candidates: Candidates) -> ContactSet:
         """Gap, normal and point of every candidate pair at the current positions."""
