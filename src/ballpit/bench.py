@@ -231,6 +231,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument("--steps", type=int, default=None, help="steps to time (default: 1 s of simulation)")
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
+    parser.add_argument(
+        "--pybullet-up-to",
+        type=int,
+        metavar="N",
+        help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
+    )
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
     parser.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
@@ -260,7 +266,8 @@ def main(argv: list[str] | None = None) -> int:
     reference: dict[tuple[str, int], Result] = {}
     for workload, n in plan:
         steps = args.steps or 240  # one simulated second
-        engines = ["ballpit"] + (["pybullet"] if args.pybullet else [])
+        with_pybullet = args.pybullet and (args.pybullet_up_to is None or n <= args.pybullet_up_to)
+        engines = ["ballpit"] + (["pybullet"] if with_pybullet else [])
         for engine in engines:
             r = run_isolated(engine, workload, n, steps, args.timeout)
             if r is None:
