@@ -49,6 +49,11 @@ class ContactBatch:
     def __len__(self) -> int:
         return len(self.a)
 
+    def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side."""
+        a, b = self.arm_a[idx], self.arm_b[idx]
+        return np.sqrt(np.einsum("ij,ij->i", a, a)), np.sqrt(np.einsum("ij,ij->i", b, b))
+
     def subset(self, mask: np.ndarray, static: int) -> ContactBatch:
         """The contacts where ``mask`` holds, coloured afresh."""
         fields = {k: v[mask] for k, v in vars(self).items() if k != "colours"}
@@ -126,12 +131,12 @@ class _Colour:
         self.rows = local[np.concatenate((idx, idx + len(batch)))]
         self.n = batch.normal[idx]
         self.nx = skew(self.n)
-        ra = np.sqrt(np.einsum("ij,ij->i", batch.arm_a[idx], batch.arm_a[idx]))
-        rb = np.sqrt(np.einsum("ij,ij->i", batch.arm_b[idx], batch.arm_b[idx]))
+        ra, rb = batch.arm_lengths(idx)
         self.ra, self.rb = ra[:, None], rb[:, None]
         ima, imb = batch.inv_mass_a[idx], batch.inv_mass_b[idx]
         iia, iib = batch.inv_inertia_a[idx], batch.inv_inertia_b[idx]
-        self.m_n = 1.0 / (ima + imb)
+        inv_m_n = ima + imb
+        self.m_n = 1.0 / inv_m_n
         inv_m_t = ima + ra**2 * iia + imb + rb**2 * iib
         self.m_t = (1.0 / inv_m_t)[:, None]
         self.m_r = (1.0 / np.maximum(iia + iib, 1e-300))[:, None]
@@ -140,7 +145,7 @@ class _Colour:
         self.turn = -np.stack((ra * iia, rb * iib)).reshape(2, k, 1)
         self.roll = np.stack((iia, -iib)).reshape(2, k, 1)
         # Bounds on how much a unit of impulse changes a contact's velocity, for the convergence test.
-        self.max_inv_m_n = float((ima + imb).max())
+        self.max_inv_m_n = float(inv_m_n.max())
         self.max_inv_m_t = float(inv_m_t.max())
         self.mu = batch.friction[idx]
         self.rolling = batch.rolling[idx]
@@ -155,15 +160,14 @@ def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses)
     n = batch.normal
     linear = imp.normal[:, None] * n + imp.friction
     turn = np.einsum("kij,kj->ki", skew(n), imp.friction)  # n × P_t
-    ra = np.sqrt(np.einsum("ij,ij->i", batch.arm_a, batch.arm_a))[:, None]
-    rb = np.sqrt(np.einsum("ij,ij->i", batch.arm_b, batch.arm_b))[:, None]
+    ra, rb = batch.arm_lengths()
     rows = len(v)
     for body, sign, im, ii, r in (
         (batch.a, 1.0, batch.inv_mass_a, batch.inv_inertia_a, ra),
         (batch.b, -1.0, batch.inv_mass_b, batch.inv_inertia_b, rb),
     ):
         dv = sign * linear * im[:, None]
-        dw = (-r * turn + sign * imp.rolling) * ii[:, None]
+        dw = (-r[:, None] * turn + sign * imp.rolling) * ii[:, None]
         for axis in range(3):
             v[:, axis] += np.bincount(body, dv[:, axis], minlength=rows)
             w[:, axis] += np.bincount(body, dw[:, axis], minlength=rows)
