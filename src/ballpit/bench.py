@@ -76,18 +76,27 @@ def settled_layout(n: int) -> tuple[np.ndarray, float]:
     return centres, side * RADIUS
 
 
+def free_layout(n: int) -> np.ndarray:
+    """``n`` ball centres on a cubic grid 1 m apart (free flight: no box, no contacts)."""
+    side = int(np.ceil(n ** (1 / 3)))
+    return np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n] * 1.0
+
+
+def _box_layout(workload: str, n: int) -> tuple[np.ndarray, float]:
+    """The ball centres and box half width of the pile or settled workload, the same for both engines."""
+    return pile_layout(n) if workload == "pile" else settled_layout(n)
+
+
 def _ballpit_world(workload: str, n: int):
     import ballpit
 
     world = ballpit.World(integrator="rk4")
     if workload == "free":
         rng = np.random.default_rng(0)
-        side = int(np.ceil(n ** (1 / 3)))
-        grid = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n]
-        world.add_spheres(grid * 1.0, radius=RADIUS, velocity=rng.normal(0, 0.1, (n, 3)))
+        world.add_spheres(free_layout(n), radius=RADIUS, velocity=rng.normal(0, 0.1, (n, 3)))
         world.gravity = (0, 0, 0)
         return world
-    centres, half = pile_layout(n) if workload == "pile" else settled_layout(n)
+    centres, half = _box_layout(workload, n)
     world.add_plane(normal=(0, 1, 0), restitution=0.5, friction=0.5, rolling_friction=0.02)
     for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
         world.add_plane(position=np.multiply(normal, -half), normal=normal, restitution=0.5)
@@ -103,10 +112,9 @@ def _pybullet_world(workload: str, n: int):
     p.setGravity(0, 0.0 if workload == "free" else -9.81, 0, physicsClientId=client)
     sphere = p.createCollisionShape(p.GEOM_SPHERE, radius=RADIUS, physicsClientId=client)
     if workload == "free":
-        side = int(np.ceil(n ** (1 / 3)))
-        centres = np.stack(np.meshgrid(*(np.arange(side),) * 3, indexing="ij"), -1).reshape(-1, 3)[:n] * 1.0
+        centres = free_layout(n)
     else:
-        centres, half = pile_layout(n) if workload == "pile" else settled_layout(n)
+        centres, half = _box_layout(workload, n)
         # y is up here too: the floor's normal is +y, walls are thin boxes.
         floor = p.createCollisionShape(p.GEOM_PLANE, planeNormal=[0, 1, 0], physicsClientId=client)
         p.createMultiBody(0, floor, physicsClientId=client)
