@@ -34,6 +34,13 @@ BROAD_PHASE_STEPS = 4
 BROAD_PHASE_REACH = 0.2
 # … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
 BROAD_PHASE_MARGIN = 0.1
+# A step in which more than this many pairs not yet touching may meet is taken whole, with
+# speculative contacts (World.crowd_limit; see World._crowded_step).
+CROWD_LIMIT = 32
+# … and the pairs that take part are those within this many times the distance they could close.
+SPECULATIVE_REACH = 2.0
+# Resting forces found over less than this fraction of a step do not warm-start the next solve.
+WARM_START_SPAN = 0.5
 # A step is split at most this many times; past it the rest of the step is taken whole.
 MAX_INTERVALS = 10_000
 # Explicit Euler's default restitution threshold, in units of |g|·dt (see _bounce_threshold).
@@ -61,6 +68,10 @@ class World:
         self.restitution_threshold = restitution_threshold
         self.time = 0.0
         self.solver_iterations = 10
+        # Steps with more pairs about to meet than this are taken whole (see _crowded_step) …
+        self.crowd_limit = CROWD_LIMIT
+        # … and this counts them.
+        self.crowded_steps = 0
         self._spheres = sphere_columns()
         self._planes = plane_columns()
         self._workspace = Workspace()
@@ -280,10 +291,11 @@ class World:
         """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
 
         The broad phase's pairs come first (kept from earlier steps while they still cover every
-        ball's path). Then the step is split at every impact, and each interval runs the same stages:
-        find the contacts, push overlapping balls apart, bounce the ones that arrive, solve the
-        resting contacts for constant forces over the interval, predict the next impact, and
-        integrate to it.
+        ball's path). A step in which few pairs can meet is split at every impact, and each interval
+        runs the same stages: find the contacts, push overlapping balls apart, bounce the ones that
+        arrive, solve the resting contacts for constant forces over the interval, predict the next
+        impact, and integrate to it. A crowded step (a pile landing) is taken whole instead, with
+        speculative contacts (see ``_crowded_step``).
         """
         dt = validation.number("dt", dt, positive=True)
         state = self._spheres.state
@@ -294,10 +306,29 @@ class World:
         events = EventLog()
         free, ang = self._free_acceleration(forces)
         candidates = self._candidate_pairs(dt, free)
+        contacts = self._narrow_phase(candidates)
+        if self._meetings(contacts, free, dt) > self.crowd_limit:
+            closing = self._closing_speed_bound(contacts, slice(None), free, dt) * dt
+            near = contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing
+            self._crowded_step(contacts.subset(near), forces, threshold, dt, events)
+            self.crowded_steps += 1
+        else:
+            self._exact_step(contacts, candidates, forces, (free, ang), threshold, dt, events)
+        self._reject_non_finite(before)
+        self.time += dt
+        return events.record()
+
+    def _exact_step(self, contacts: ContactSet, candidates: Candidates, forces: list[ForceTerm],
+                    accel: tuple[np.ndarray, np.ndarray], threshold: float, dt: float,
+                    events: EventLog) -> None:  # fmt: skip
+        """The step split at every impact, so balls meet exactly when they touch."""
+        state = self._spheres.state
+        free, ang = accel
         elapsed, intervals = 0.0, 0
         while elapsed < dt:
             remaining = dt - elapsed
-            contacts = self._narrow_phase(candidates)
+            if intervals:
+                contacts = self._narrow_phase(candidates)
             touching = contacts.subset(contacts.gap < CONTACT_SLOP)
             batch = self._contact_batch(touching)
             self._remove_penetration(touching, batch)
@@ -305,7 +336,7 @@ class World:
             self._bounce(touching, batch, threshold, events, now)
             if intervals or len(touching):  # velocities may have changed since the step began
                 free, ang = self._free_acceleration(forces)
-            push = self._resting_forces(touching, batch, free, ang, remaining, events, now)
+            push = self._resting_forces(touching, batch, free, ang, remaining, dt, events, now)
             lin = free if push is None else free + push.lin
             # The first interval's free path was checked against the boxes when the pairs were taken.
             if (intervals or push is not None) and self._escapes_boxes(candidates, lin, remaining):
@@ -321,9 +352,28 @@ class World:
             integrate(self._integrator, state, terms, h, self._workspace)
             events.close_interval(h / remaining)
             elapsed = dt if h >= remaining else elapsed + h
-        self._reject_non_finite(before)
-        self.time += dt
-        return events.record()
+
+    def _crowded_step(self, c: ContactSet, forces: list[ForceTerm], threshold: float, dt: float,
+                      events: EventLog) -> None:  # fmt: skip
+        """The whole step as one interval, with speculative contacts (Catto, "Speculative Contacts",
+        2013; Box2D v3's solver).
+
+        When many pairs may meet within the step, splitting it at each impact costs a pass over the
+        world per impact. Instead every pair that could meet within the step joins the solves as a
+        contact with a gap: it may close by at most that gap, v_n ≥ −gap/dt, and the constraint only
+        pushes if the pair would otherwise pass it. A pair arriving faster than the bounce threshold
+        leaves at e times its approach speed, as in an exact step, but from where it was when the
+        step began: a bounce is early by at most the gap it had left (≤ v·dt).
+        """
+        state = self._spheres.state
+        allowed = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
+        batch = self._contact_batch(c)
+        self._remove_penetration(c, batch)
+        self._bounce(c, batch, threshold, events, self.time, allowed)
+        free, ang = self._free_acceleration(forces)
+        push = self._resting_forces(c, batch, free, ang, dt, dt, events, self.time, allowed)
+        integrate(self._integrator, state, forces if push is None else [*forces, push], dt, self._workspace)
+        events.close_interval(1.0)
 
     # ------------------------------------------------------------------ step stages
     def _free_acceleration(self, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
@@ -486,21 +536,22 @@ class World:
             pos[-1] = 0.0
         x[:] = pos[:-1]
 
-    def _bounce(
-        self, c: ContactSet, batch: ContactBatch, threshold: float, events: EventLog, now: float
-    ) -> None:
+    def _bounce(self, c: ContactSet, batch: ContactBatch, threshold: float, events: EventLog, now: float,
+                allowed: np.ndarray | None = None) -> None:  # fmt: skip
         """Impacts: contacts arriving faster than the threshold leave at e times their approach speed.
 
         The touching contacts within BOUNCE_HOPS balls of an arriving one take part, so a ball landing
-        on a stack pushes through it; contacts arriving slower than the threshold just stop.
+        on a stack pushes through it; contacts arriving slower than the threshold just stop. A
+        speculative contact may approach at its ``allowed`` speed (gap/dt) and arrives only faster.
         """
         if len(c) == 0:
             return
+        allowed = np.zeros(len(c)) if allowed is None else allowed
         v, w = self._velocities()
         ra, rb = batch.arm_a, batch.arm_b
         rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
         vn = np.einsum("ij,ij->i", rel, c.normal)
-        approaching = vn < -APPROACH_SPEED
+        approaching = vn < -(allowed + APPROACH_SPEED)
         if not approaching.any():
             return
         # The island around the impacts: contacts within BOUNCE_HOPS balls of an approaching one.
@@ -513,7 +564,8 @@ class World:
             involved[n] = False
             near = involved[c.a] | involved[c.b]
         island = batch.subset(near, n)
-        target = np.where(-vn[near] > threshold, -island.restitution * vn[near], 0.0)
+        arrives = approaching[near] & (-vn[near] > threshold)
+        target = np.where(arrives, -island.restitution * vn[near], -allowed[near])
         imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), self.solver_iterations)
         state = self._spheres.state
         state[:, V] = v[:-1]
@@ -528,14 +580,22 @@ class World:
         lin: np.ndarray,
         ang: np.ndarray,
         h: float,
+        dt: float,
         events: EventLog,
         now: float,
+        allowed: np.ndarray | None = None,
     ) -> ConstantPerBall | None:
         """Constant contact forces over the next ``h`` seconds that leave every touching contact
-        not approaching, not slipping beyond the friction cone, at the end of the interval.
+        not approaching, not slipping beyond the friction cone, at the end of the interval (a
+        speculative contact may approach at its ``allowed`` speed).
 
         Solving for end-of-interval velocities and applying the impulses as constant forces keeps the
         integrators exact: a resting ball's force cancels gravity, so it reports zero velocity.
+
+        The forces warm-start the next solve only when ``h`` is at least WARM_START_SPAN of the step
+        ``dt``: the force that stops a slow arrival in the last sliver of a step is no force to hold
+        for the next whole step. Warm-started with it, a column of balls is pre-stressed: the impulses
+        cancel ball by ball, so the sweeps see nothing to correct until the stress reaches the top.
         """
         n = self._spheres.count
         if len(c) == 0:
@@ -547,10 +607,13 @@ class World:
         keys = c.keys(n)
         imp = self._warm_impulses(keys, c.normal, h)
         solver.warm_start(batch, v, w, imp)
-        solver.solve(batch, v, w, np.zeros(len(c)), imp, self.solver_iterations)
-        order = np.argsort(keys)
-        self._warm_keys = keys[order]
-        self._warm_forces = Impulses(imp.normal[order] / h, imp.friction[order] / h, imp.rolling[order] / h)
+        target = np.zeros(len(c)) if allowed is None else -allowed
+        solver.solve(batch, v, w, target, imp, self.solver_iterations)
+        if h >= WARM_START_SPAN * dt:
+            order = np.argsort(keys)
+            self._warm_keys = keys[order]
+            parts = (imp.normal, imp.friction, imp.rolling)
+            self._warm_forces = Impulses(*(part[order] / h for part in parts))
         events.add_resting(now, c, keys, imp.normal)
         return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)
 
@@ -581,7 +644,7 @@ class World:
         x, v = np.vstack((state[:, X], np.zeros(3))), np.vstack((state[:, V], np.zeros(3)))
         acc = np.vstack((accel, np.zeros(3))) if self._integrator.quadratic_path else np.zeros((len(x), 3))
         a, b = c.a[apart], c.b[apart]
-        bound = np.linalg.norm(v[a] - v[b], axis=1) + np.linalg.norm(acc[a] - acc[b], axis=1) * h
+        bound = self._closing_speed_bound(c, apart, accel, h)
         reachable = c.gap[apart] <= bound * h
         apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
         if apart.size == 0:
@@ -615,6 +678,28 @@ class World:
         overlap = (t - t[0]) * np.maximum.accumulate(speed)
         allowed = IMPACT_OVERLAP * float(self._spheres.radius.min())
         return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
+
+    def _meetings(self, c: ContactSet, accel: np.ndarray, h: float) -> int:
+        """How many pairs not yet touching would meet within ``h``, moving along today's normals."""
+        apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+        state = self._spheres.state
+        v = np.vstack((state[:, V], np.zeros(3)))
+        acc = np.vstack((accel, np.zeros(3)))
+        a, b, n = c.a[apart], c.b[apart], c.normal[apart]
+        # the gap after h along the normal: g + v_n·h + ½·a_n·h²
+        rel = (v[a] - v[b]) * h + 0.5 * h * h * (acc[a] - acc[b])
+        return int(np.count_nonzero(c.gap[apart] + np.einsum("ij,ij->i", rel, n) < CONTACT_SLOP))
+
+    def _closing_speed_bound(self, c: ContactSet, idx: np.ndarray, accel: np.ndarray, h: float) -> np.ndarray:
+        """A bound on how fast each pair ``idx`` can close over the next ``h``: |Δv| + |Δa|·h."""
+        state = self._spheres.state
+        v = np.vstack((state[:, V], np.zeros(3)))
+        a, b = c.a[idx], c.b[idx]
+        bound = np.linalg.norm(v[a] - v[b], axis=1)
+        if self._integrator.quadratic_path:
+            acc = np.vstack((accel, np.zeros(3)))
+            bound += np.linalg.norm(acc[a] - acc[b], axis=1) * h
+        return bound
 
     def _bounce_threshold(self, dt: float) -> float:
         """The approach speed below which contacts do not bounce.
