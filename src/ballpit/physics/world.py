@@ -546,26 +546,29 @@ class World:
         """
         if len(c) == 0:
             return
-        allowed = np.zeros(len(c)) if allowed is None else allowed
+        speculative, allowed = allowed, np.zeros(len(c)) if allowed is None else allowed
         v, w = self._velocities()
         ra, rb = batch.arm_a, batch.arm_b
         rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
         vn = np.einsum("ij,ij->i", rel, c.normal)
         approaching = vn < -(allowed + APPROACH_SPEED)
-        if not approaching.any():
+        arriving = approaching & (-vn > threshold)
+        # In a crowded step only real impacts start an island: a slower approach is stopped by the
+        # resting forces within the step (an overlap of at most threshold·dt/2, removed next step).
+        seeds = approaching if speculative is None else arriving
+        if not seeds.any():
             return
         # The island around the impacts: contacts within BOUNCE_HOPS balls of an approaching one.
         n = self._spheres.count
         involved = np.zeros(n + 1, bool)
-        near = approaching
+        near = seeds
         for _ in range(BOUNCE_HOPS):
             involved[c.a[near]] = True
             involved[c.b[near]] = True
             involved[n] = False
             near = involved[c.a] | involved[c.b]
         island = batch.subset(near, n)
-        arrives = approaching[near] & (-vn[near] > threshold)
-        target = np.where(arrives, -island.restitution * vn[near], -allowed[near])
+        target = np.where(arriving[near], -island.restitution * vn[near], -allowed[near])
         imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), self.solver_iterations)
         state = self._spheres.state
         state[:, V] = v[:-1]
