@@ -23,6 +23,19 @@ def grid(side: int, spacing: float, height: float) -> np.ndarray:
     return np.column_stack((xz[:, 0], np.full(len(xz), height), xz[:, 1]))
 
 
+def first_apexes(world: ballpit.World, dt: float, duration: float) -> np.ndarray:
+    """Each ball's lowest point at its first apex after a bounce (y − r + v²/2g, exact in flight)."""
+    spheres = world.spheres
+    previous, apex = spheres.velocities[:, 1].copy(), np.full(len(spheres), np.nan)
+    for _ in range(round(duration / dt)):
+        world.step(dt)
+        vy = spheres.velocities[:, 1]
+        rising = (previous < 0) & (vy > 0) & np.isnan(apex)
+        apex[rising] = spheres.positions[rising, 1] - spheres.radii[rising] + vy[rising] ** 2 / (2 * G)
+        previous = vy.copy()
+    return apex
+
+
 @pytest.mark.parametrize("rate", [60, 240])
 def test_a_crowd_landing_in_one_step_bounces_to_e_squared_h_within_one_steps_travel(rate):
     # 100 balls 1 m above the floor land in the same step. A bounce taken at the start of that step,
@@ -32,14 +45,7 @@ def test_a_crowd_landing_in_one_step_bounces_to_e_squared_h_within_one_steps_tra
     world.add_plane(restitution=e, friction=0.0)
     world.add_spheres(grid(10, 0.5, h + r), radius=r, restitution=1.0, friction=0.0)
     v_land = math.sqrt(2 * G * h)
-    previous = world.spheres.velocities[:, 1].copy()
-    apex = np.full(100, np.nan)
-    for _ in range(round(1.2 / dt)):
-        world.step(dt)
-        vy = world.spheres.velocities[:, 1]
-        rising = (previous < 0) & (vy > 0) & np.isnan(apex)
-        apex[rising] = world.spheres.positions[rising, 1] - r + vy[rising] ** 2 / (2 * G)
-        previous = vy.copy()
+    apex = first_apexes(world, dt, 1.2)
     assert world.crowded_steps >= 1
     assert not np.isnan(apex).any()
     assert apex.min() >= e**2 * h - 1e-9
@@ -121,3 +127,25 @@ def test_a_crowded_pile_landing_never_gains_energy_and_nothing_sinks():
         assert x[:, 1].min() > r - 0.1 * r
     assert world.crowded_steps > 20
     assert worst_overlap < 0.1 * r
+
+
+@pytest.mark.parametrize(
+    ("value", "error"), [(-1, ValueError), (float("nan"), ValueError), ("many", TypeError)]
+)
+def test_crowd_limit_rejects_bad_values_naming_it(value, error):
+    world = ballpit.World()
+    with pytest.raises(error, match="crowd_limit"):
+        world.crowd_limit = value
+    world.crowd_limit = float("inf")  # always split steps at impacts: allowed
+
+
+def test_with_no_crowd_limit_a_crowd_landing_is_split_at_its_impacts_and_bounces_exactly():
+    # The same 100 balls as above, with crowded steps switched off: every apex is e²·h.
+    dt, e, h, r = 1 / 60, 0.6, 1.0, 0.1
+    world = ballpit.World()
+    world.crowd_limit = float("inf")
+    world.add_plane(restitution=e, friction=0.0)
+    world.add_spheres(grid(10, 0.5, h + r), radius=r, restitution=1.0, friction=0.0)
+    apex = first_apexes(world, dt, 1.2)
+    assert world.crowded_steps == 0
+    assert apex == pytest.approx(np.full(100, e**2 * h), abs=1e-5)

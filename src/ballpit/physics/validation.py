@@ -23,12 +23,14 @@ def vector(name: str, value: object, length: int = 3) -> np.ndarray:
     return arr
 
 
-def number(name: str, value: object, *, positive: bool = False, nonnegative: bool = False) -> float:
-    """A finite float, optionally > 0 or ≥ 0."""
+def number(
+    name: str, value: object, *, positive: bool = False, nonnegative: bool = False, infinite: bool = False
+) -> float:
+    """A finite float (or ±inf if ``infinite``; never NaN), optionally > 0 or ≥ 0."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise TypeError(f"{name} must be a number, got {value!r}")
     x = float(value)
-    if not math.isfinite(x):
+    if math.isnan(x) or (math.isinf(x) and not infinite):
         raise ValueError(f"{name} must be finite, got {value!r}")
     if positive and x <= 0.0:
         raise ValueError(f"{name} must be positive, got {value!r}")

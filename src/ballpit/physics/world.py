@@ -68,10 +68,8 @@ class World:
         self.restitution_threshold = restitution_threshold
         self.time = 0.0
         self.solver_iterations = 10
-        # Steps with more pairs about to meet than this are taken whole (see _crowded_step) …
         self.crowd_limit = CROWD_LIMIT
-        # … and this counts them.
-        self.crowded_steps = 0
+        self.crowded_steps = 0  # how many steps were taken whole, with speculative contacts
         self._spheres = sphere_columns()
         self._planes = plane_columns()
         self._workspace = Workspace()
@@ -115,6 +113,16 @@ class World:
     @angular_drag.setter
     def angular_drag(self, value: float) -> None:
         self._angular_drag = validation.number("angular_drag", value, nonnegative=True)
+
+    @property
+    def crowd_limit(self) -> float:
+        """A step in which more pairs than this may meet is taken whole, with speculative contacts
+        (``inf``: always split the step at each impact; 0: take every step with an impact whole)."""
+        return self._crowd_limit
+
+    @crowd_limit.setter
+    def crowd_limit(self, value: float) -> None:
+        self._crowd_limit = validation.number("crowd_limit", value, nonnegative=True, infinite=True)
 
     @property
     def restitution_threshold(self) -> float | None:
