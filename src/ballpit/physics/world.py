@@ -363,15 +363,17 @@ class World:
 
     def _crowded_step(self, c: ContactSet, forces: list[ForceTerm], threshold: float, dt: float,
                       events: EventLog) -> None:  # fmt: skip
-        """The whole step as one interval, with speculative contacts (Catto, "Speculative Contacts",
-        2013; Box2D v3's solver).
+        """The whole step as one interval, with speculative contacts (P. Firth, "Speculative
+        contacts", 2011; as in Box2D v3 and Bullet).
 
         When many pairs may meet within the step, splitting it at each impact costs a pass over the
         world per impact. Instead every pair that could meet within the step joins the solves as a
         contact with a gap: it may close by at most that gap, v_n ≥ −gap/dt, and the constraint only
         pushes if the pair would otherwise pass it. A pair arriving faster than the bounce threshold
         leaves at e times its approach speed, as in an exact step, but from where it was when the
-        step began: a bounce is early by at most the gap it had left (≤ v·dt).
+        step began: a bounce is early by at most the gap it had left (≤ v·dt). Pairs missed because a
+        bounce turned a ball towards a ball it was not near overlap slightly; the next step's
+        penetration removal and bounce deal with them, and its broad phase checks every path again.
         """
         state = self._spheres.state
         allowed = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
