@@ -315,10 +315,9 @@ class World:
         free, ang = self._free_acceleration(forces)
         candidates = self._candidate_pairs(dt, free)
         contacts = self._narrow_phase(candidates)
-        if self._meetings(contacts, free, dt) > self.crowd_limit:
-            closing = self._closing_speed_bound(contacts, slice(None), free, dt) * dt
-            near = contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing
-            self._crowded_step(contacts.subset(near), forces, threshold, dt, events)
+        crowd = self._crowd(contacts, free, dt)
+        if crowd is not None:
+            self._crowded_step(crowd, forces, threshold, dt, events)
             self.crowded_steps += 1
         else:
             self._exact_step(contacts, candidates, forces, (free, ang), threshold, dt, events)
@@ -521,7 +520,7 @@ class World:
     def _velocities(self) -> tuple[np.ndarray, np.ndarray]:
         """Copies of v and ω with the static row N (always zero) appended."""
         state = self._spheres.state
-        return np.vstack((state[:, V], np.zeros(3))), np.vstack((state[:, W], np.zeros(3)))
+        return _with_static(state[:, V]), _with_static(state[:, W])
 
     def _remove_penetration(self, c: ContactSet, batch: ContactBatch) -> None:
         """Move overlapping balls apart along the contact normals, positions only (no velocity is added).
@@ -532,7 +531,7 @@ class World:
         if not np.any(c.gap < -OVERLAP_TOLERANCE):
             return
         x = self._spheres.state[:, X]
-        pos = np.vstack((x, np.zeros(3)))
+        pos = _with_static(x)
         n = c.normal
         offset = np.einsum("ij,ij->i", n, pos[c.a] - pos[c.b]) - c.gap
         share = batch.inv_mass_a / (batch.inv_mass_a + batch.inv_mass_b)
@@ -556,7 +555,8 @@ class World:
         """
         if len(c) == 0:
             return
-        speculative, allowed = allowed, np.zeros(len(c)) if allowed is None else allowed
+        crowded = allowed is not None
+        allowed = allowed if crowded else np.zeros(len(c))
         v, w = self._velocities()
         ra, rb = batch.arm_a, batch.arm_b
         rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
@@ -565,7 +565,7 @@ class World:
         arriving = approaching & (-vn > threshold)
         # In a crowded step only real impacts start an island: a slower approach is stopped by the
         # resting forces within the step (an overlap of at most threshold·dt/2, removed next step).
-        seeds = approaching if speculative is None else arriving
+        seeds = arriving if crowded else approaching
         if not seeds.any():
             return
         # The island around the impacts: contacts within BOUNCE_HOPS balls of an approaching one.
@@ -654,10 +654,10 @@ class World:
         if apart.size == 0:
             return np.inf
         state = self._spheres.state
-        x, v = np.vstack((state[:, X], np.zeros(3))), np.vstack((state[:, V], np.zeros(3)))
-        acc = np.vstack((accel, np.zeros(3))) if self._integrator.quadratic_path else np.zeros((len(x), 3))
+        x, v = _with_static(state[:, X]), _with_static(state[:, V])
+        acc = _with_static(accel) if self._integrator.quadratic_path else np.zeros((len(x), 3))
         a, b = c.a[apart], c.b[apart]
-        bound = self._closing_speed_bound(c, apart, accel, h)
+        bound = _closing_speed_bound(v[a] - v[b], acc[a] - acc[b], h)
         reachable = c.gap[apart] <= bound * h
         apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
         if apart.size == 0:
@@ -692,27 +692,21 @@ class World:
         allowed = IMPACT_OVERLAP * float(self._spheres.radius.min())
         return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
 
-    def _meetings(self, c: ContactSet, accel: np.ndarray, h: float) -> int:
-        """How many pairs not yet touching would meet within ``h``, moving along today's normals."""
-        apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
-        state = self._spheres.state
-        v = np.vstack((state[:, V], np.zeros(3)))
-        acc = np.vstack((accel, np.zeros(3)))
-        a, b, n = c.a[apart], c.b[apart], c.normal[apart]
-        # the gap after h along the normal: g + v_n·h + ½·a_n·h²
-        rel = (v[a] - v[b]) * h + 0.5 * h * h * (acc[a] - acc[b])
-        return int(np.count_nonzero(c.gap[apart] + np.einsum("ij,ij->i", rel, n) < CONTACT_SLOP))
+    def _crowd(self, c: ContactSet, accel: np.ndarray, dt: float) -> ContactSet | None:
+        """The contacts of a crowded step, or None when few enough pairs meet to split the step.
 
-    def _closing_speed_bound(self, c: ContactSet, idx: np.ndarray, accel: np.ndarray, h: float) -> np.ndarray:
-        """A bound on how fast each pair ``idx`` can close over the next ``h``: |Δv| + |Δa|·h."""
-        state = self._spheres.state
-        v = np.vstack((state[:, V], np.zeros(3)))
-        a, b = c.a[idx], c.b[idx]
-        bound = np.linalg.norm(v[a] - v[b], axis=1)
-        if self._integrator.quadratic_path:
-            acc = np.vstack((accel, np.zeros(3)))
-            bound += np.linalg.norm(acc[a] - acc[b], axis=1) * h
-        return bound
+        Meetings are counted along today's normals: the gap after dt, g + v_n·dt + ½·a_n·dt², falls to
+        contact. The step's contacts are every pair within SPECULATIVE_REACH times the distance it
+        could close (by the same bound the time of impact uses), touching ones included.
+        """
+        v, acc = _with_static(self._spheres.state[:, V]), _with_static(accel)
+        dv, da = v[c.a] - v[c.b], acc[c.a] - acc[c.b]
+        ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
+        if np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP)) <= self.crowd_limit:
+            return None
+        path_da = da if self._integrator.quadratic_path else np.zeros_like(da)
+        closing = _closing_speed_bound(dv, path_da, dt) * dt
+        return c.subset(c.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing)
 
     def _bounce_threshold(self, dt: float) -> float:
         """The approach speed below which contacts do not bounce.
@@ -760,3 +754,14 @@ class World:
             bad = int(np.flatnonzero(~np.isfinite(state).all(axis=1))[0])
             state[:] = before
             raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
+
+
+def _with_static(rows: np.ndarray) -> np.ndarray:
+    """Per-ball rows with the static world's zero row N appended (planes are body N in the solver)."""
+    return np.vstack((rows, np.zeros(rows.shape[1])))
+
+
+def _closing_speed_bound(dv: np.ndarray, da: np.ndarray, h: float) -> np.ndarray:
+    """A bound on how fast each pair can close over the next ``h``, from the relative velocity and
+    acceleration along the integrator's path (zero acceleration for Euler): |Δv| + |Δa|·h."""
+    return np.linalg.norm(dv, axis=1) + np.linalg.norm(da, axis=1) * h
