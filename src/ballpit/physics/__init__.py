@@ -2,6 +2,7 @@
 
 from .bodies import Plane, Sphere
 from .contacts import Contacts
-from .world import World
+from .integrators import INTEGRATOR_NAMES
+from .world import DEFAULT_TIMESTEP, World
 
-__all__ = ["Contacts", "Plane", "Sphere", "World"]
+__all__ = ["DEFAULT_TIMESTEP", "INTEGRATOR_NAMES", "Contacts", "Plane", "Sphere", "World"]

@@ -97,6 +97,8 @@ INTEGRATORS: dict[str, Integrator] = {
     "rk2": Integrator("rk2", rk2, quadratic_path=True),
     "rk4": Integrator("rk4", rk4, quadratic_path=True),
 }
+# The names a World, a scene file and the command line accept, in order of accuracy.
+INTEGRATOR_NAMES: tuple[str, ...] = tuple(INTEGRATORS)
 
 
 def integrate(

@@ -12,6 +12,9 @@ from .integrators import INTEGRATORS, Integrator, Workspace, integrate
 from .solver import ContactBatch, Impulses
 from .state import Q, V, W, X, plane_columns, sphere_columns
 
+# The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
+DEFAULT_TIMESTEP = 1.0 / 240.0
+
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
 SOLID_INERTIA = 2.0 / 5.0
 HOLLOW_INERTIA = 2.0 / 3.0
