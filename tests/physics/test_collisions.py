@@ -111,6 +111,6 @@ def test_stepping_the_same_scene_twice_is_bit_identical():
         grid = np.stack(np.meshgrid(np.arange(4), np.arange(4), np.arange(4)), -1).reshape(-1, 3) * 0.25
         world.add_spheres(grid + rng.normal(0, 0.01, grid.shape) + [-0.4, 2.0, -0.4], radius=0.1)
         run(world, 240)
-        return world._spheres.state.copy()
+        return world.state.body.copy()
 
     assert np.array_equal(simulate(), simulate())

@@ -34,7 +34,7 @@ def test_adding_ten_thousand_balls_one_by_one_grows_storage_geometrically():
     capacities = set()
     for i in range(10_000):
         world.add_sphere(position=(i, 0, 0), radius=0.1)
-        capacities.add(world._spheres.capacity)
+        capacities.add(world.state.capacity)
     assert len(world.spheres) == 10_000
     assert len(capacities) <= math.ceil(math.log2(10_000 / 16)) + 1  # doubling: a copy per power of two
     assert world.spheres[-1].position == pytest.approx([9999, 0, 0])
@@ -160,7 +160,7 @@ def test_setting_a_non_finite_value_is_rejected_and_the_world_keeps_no_nan():
         world.step(-0.1)
     with pytest.raises(ValueError, match="integrator"):
         world.integrator = "verlet"
-    assert np.isfinite(world._spheres.state).all()
+    assert np.isfinite(world.state.body).all()
 
 
 def test_step_advances_time():

@@ -22,14 +22,14 @@ if TYPE_CHECKING:
 
 def _state_vector(cols: slice, name: str, length: int):
     def get(self: Sphere) -> np.ndarray:
-        return self._world._spheres.state[self.index, cols]
+        return self._world.state.body[self.index, cols]
 
     def set(self: Sphere, value: object) -> None:
         if name == "orientation":
             vec = validation.quaternion(name, value)
         else:
             vec = validation.vector(name, value, length)
-        self._world._spheres.state[self.index, cols] = vec
+        self._world.state.body[self.index, cols] = vec
 
     return property(get, set, doc=f"The ball's {name.replace('_', ' ')} (world frame).")
 
@@ -55,7 +55,7 @@ class Sphere:
 
     @property
     def _columns(self) -> Columns:
-        return self._world._spheres
+        return self._world.model.spheres
 
     position = _state_vector(X, "position", 3)
     velocity = _state_vector(V, "velocity", 3)
@@ -98,7 +98,7 @@ class Plane:
 
     @property
     def _columns(self) -> Columns:
-        return self._world._planes
+        return self._world.model.planes
 
     restitution = _material("restitution", "plane")
     friction = _material("friction", "plane")
@@ -165,6 +165,13 @@ class Plane:
         return f"Plane(index={self.index}, normal=({n[0]:.3g}, {n[1]:.3g}, {n[2]:.3g}), size={self.size})"
 
 
+def _read_only(column: np.ndarray) -> np.ndarray:
+    """A view of ``column`` that refuses writes: a column others are derived from."""
+    view = column.view()
+    view.flags.writeable = False
+    return view
+
+
 class _Views(Sequence):
     _view: type
 
@@ -202,31 +209,33 @@ class SphereList(_Views):
     _view = Sphere
 
     def _count(self) -> int:
-        return self._world._spheres.count
+        return self._world.state.count
 
     @property
     def positions(self) -> np.ndarray:
-        return self._world._spheres.state[:, X]
+        return self._world.state.body[:, X]
 
     @property
     def velocities(self) -> np.ndarray:
-        return self._world._spheres.state[:, V]
+        return self._world.state.body[:, V]
 
     @property
     def orientations(self) -> np.ndarray:
-        return self._world._spheres.state[:, Q]
+        return self._world.state.body[:, Q]
 
     @property
     def angular_velocities(self) -> np.ndarray:
-        return self._world._spheres.state[:, W]
+        return self._world.state.body[:, W]
 
     @property
     def radii(self) -> np.ndarray:
-        return self._world._spheres.radius
+        """Every ball's radius, read-only (the inertia and the broad phase derive from it)."""
+        return _read_only(self._world.model.spheres.radius)
 
     @property
     def masses(self) -> np.ndarray:
-        return self._world._spheres.mass
+        """Every ball's mass, read-only (the inverse mass and inertia derive from it)."""
+        return _read_only(self._world.model.spheres.mass)
 
 
 class PlaneList(_Views):
@@ -235,24 +244,24 @@ class PlaneList(_Views):
     _view = Plane
 
     def _count(self) -> int:
-        return self._world._planes.count
+        return self._world.model.planes.count
 
     @property
     def centers(self) -> np.ndarray:
-        return self._world._planes.center
+        return self._world.model.planes.center
 
     @property
     def normals(self) -> np.ndarray:
-        return self._world._planes.normal
+        return self._world.model.planes.normal
 
     @property
     def orientations(self) -> np.ndarray:
-        return self._world._planes.orientation
+        return self._world.model.planes.orientation
 
     @property
     def half_sizes(self) -> np.ndarray:
-        return self._world._planes.half_size
+        return self._world.model.planes.half_size
 
     @property
     def restitutions(self) -> np.ndarray:
-        return self._world._planes.restitution
+        return self._world.model.planes.restitution

@@ -1,4 +1,13 @@
-"""The record of contacts a step resolved: equal-length arrays, one entry per contact."""
+"""Contacts at two points in a step, each a structure of equal-length arrays, one entry per pair:
+
+- ``ContactPoints``: every kept pair measured by the narrow phase at the current positions (gap,
+  normal, point), touching or not;
+- ``ContactRecord`` (public as ``ballpit.Contacts``): what one step resolved, one entry per pair, with
+  its total impulse; ``EventLog`` collects it over the step's intervals.
+
+The solver's own per-contact rows (masses, lever arms, mixed materials) are ``rows.ContactRows``, and
+the broad phase's pairs are ``pairs.KeptPairs``.
+"""
 
 from __future__ import annotations
 
@@ -12,8 +21,8 @@ KIND_NAMES = ("sphere-plane", "sphere-sphere")
 
 
 @dataclass(frozen=True)
-class Contacts:
-    """Contacts resolved in one step.
+class ContactRecord:
+    """Contacts resolved in one step (``World.step`` returns it; public as ``ballpit.Contacts``).
 
     ``time`` when each was resolved (world time, s); ``kind`` SPHERE_PLANE (0) or SPHERE_SPHERE (1);
     ``a`` the sphere; ``b`` the plane index (sphere-plane) or the other sphere; ``point`` (K, 3) the contact
@@ -38,8 +47,8 @@ class Contacts:
         return np.asarray(KIND_NAMES)[self.kind]
 
     @staticmethod
-    def empty() -> Contacts:
-        return Contacts(
+    def empty() -> ContactRecord:
+        return ContactRecord(
             time=np.zeros(0),
             kind=np.zeros(0, np.int8),
             a=np.zeros(0, np.intp),
@@ -50,38 +59,23 @@ class Contacts:
         )
 
     @staticmethod
-    def concatenate(parts: list[Contacts]) -> Contacts:
+    def concatenate(parts: list[ContactRecord]) -> ContactRecord:
         if not parts:
-            return Contacts.empty()
+            return ContactRecord.empty()
         if len(parts) == 1:
             return parts[0]
-        return Contacts(
-            **{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Contacts)}
+        return ContactRecord(
+            **{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(ContactRecord)}
         )
 
 
-@dataclass
-class Candidates:
-    """Pairs the broad phase found for the rest of the step, with the boxes they were found from."""
-
-    lo: np.ndarray  # (N, 3) swept boxes
-    hi: np.ndarray
-    centre: np.ndarray  # (N, 3) and (N,): a sphere around each ball's swept path, tighter than its box
-    reach: np.ndarray
-    pair_i: np.ndarray  # sphere–sphere pairs, i < j
-    pair_j: np.ndarray
-    sphere: np.ndarray  # sphere–plane pairs
-    plane: np.ndarray
-    side: np.ndarray  # ±1: the side of the plane the ball is on
-    counts: tuple[int, int]  # balls and planes in the world when the pairs were found
-
-    def __len__(self) -> int:
-        return len(self.pair_i) + len(self.sphere)
+# The public name (``ballpit.Contacts``): what ``World.step`` returns.
+Contacts = ContactRecord
 
 
 @dataclass
-class ContactSet:
-    """Every candidate pair evaluated at the current positions; sphere–plane pairs first.
+class ContactPoints:
+    """Every kept pair measured at the current positions; sphere–plane pairs first.
 
     ``b`` is the other ball's row, or the static row N for a plane; ``other`` is what the events
     report as b (the plane's or the other ball's index).
@@ -98,17 +92,27 @@ class ContactSet:
     def __len__(self) -> int:
         return len(self.a)
 
-    def subset(self, mask: np.ndarray) -> ContactSet:
-        return ContactSet(**{f.name: getattr(self, f.name)[mask] for f in fields(ContactSet)})
+    def subset(self, mask: np.ndarray) -> ContactPoints:
+        return ContactPoints(**{f.name: getattr(self, f.name)[mask] for f in fields(ContactPoints)})
 
-    def keys(self, n_spheres: int) -> np.ndarray:
-        """A unique integer per pair, stable from step to step (for warm starting)."""
-        second = np.where(self.kind == SPHERE_SPHERE, self.other, n_spheres + self.other)
-        return self.a.astype(np.int64) * (2 * n_spheres + 2**20) + second
+    def keys(self) -> np.ndarray:
+        """A unique integer per pair, built from the pair's own identity (the ball's index and the
+        other ball's or the plane's), so a key never changes meaning when bodies are added."""
+        return pair_keys(self.a, self.other, self.kind == SPHERE_PLANE)
+
+
+# A pair's key: ball a in the high 32 bits; in the low 32, the other ball, or a plane with bit 31 set.
+_PLANE_BIT = np.int64(1 << 31)
+
+
+def pair_keys(a: np.ndarray, other: np.ndarray, on_plane: np.ndarray) -> np.ndarray:
+    """Stable identities of pairs (ball ``a``, ball or plane ``other``) for the warm-start cache."""
+    second = other.astype(np.int64) + np.where(on_plane, _PLANE_BIT, np.int64(0))
+    return (a.astype(np.int64) << np.int64(32)) | second
 
 
 class EventLog:
-    """Collects the impulses of one step and merges them into one ``Contacts`` entry per pair.
+    """Collects the impulses of one step and merges them into one ``ContactRecord`` entry per pair.
 
     Resting impulses are solved for the whole remaining step but applied only over the interval
     actually taken, so they are scaled by that fraction when the interval closes.
@@ -118,12 +122,14 @@ class EventLog:
         self._parts: list[tuple] = []
         self._pending: tuple | None = None
 
-    def add(self, time: float, contacts: ContactSet, keys: np.ndarray, impulse: np.ndarray) -> None:
+    def add(self, time: float, contacts: ContactPoints, keys: np.ndarray, impulse: np.ndarray) -> None:
         hit = impulse > 0.0
         if hit.any():
             self._parts.append((np.full(int(hit.sum()), time), contacts.subset(hit), keys[hit], impulse[hit]))
 
-    def add_resting(self, time: float, contacts: ContactSet, keys: np.ndarray, impulse: np.ndarray) -> None:
+    def add_resting(
+        self, time: float, contacts: ContactPoints, keys: np.ndarray, impulse: np.ndarray
+    ) -> None:
         self._pending = (time, contacts, keys, impulse)
 
     def close_interval(self, fraction: float) -> None:
@@ -132,16 +138,16 @@ class EventLog:
             self.add(time, contacts, keys, impulse * fraction)
             self._pending = None
 
-    def record(self) -> Contacts:
+    def record(self) -> ContactRecord:
         if not self._parts:
-            return Contacts.empty()
+            return ContactRecord.empty()
         time = np.concatenate([p[0] for p in self._parts])
         keys = np.concatenate([p[2] for p in self._parts])
         impulse = np.concatenate([p[3] for p in self._parts])
-        c = ContactSet(
+        c = ContactPoints(
             **{
                 f.name: np.concatenate([getattr(p[1], f.name) for p in self._parts])
-                for f in fields(ContactSet)
+                for f in fields(ContactPoints)
             }
         )
         # One entry per pair: the first time it was resolved (its point and normal then), the total impulse.
@@ -150,7 +156,7 @@ class EventLog:
         np.add.at(total, inverse, impulse)
         order = np.lexsort((first, time[first]))
         first = first[order]
-        return Contacts(
+        return ContactRecord(
             time=time[first],
             kind=c.kind[first].astype(np.int8),
             a=c.a[first],

@@ -59,3 +59,12 @@ class ConstantPerBall:
     def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
         lin += self.lin
         ang += self.ang
+
+
+def free_acceleration(body: np.ndarray, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
+    """Linear and angular acceleration of each ball from the force terms alone, at state ``body``."""
+    lin = np.zeros((len(body), 3))
+    ang = np.zeros((len(body), 3))
+    for term in forces:
+        term.add(body, lin, ang)
+    return lin, ang

@@ -24,40 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .rows import ContactRows
+
 # A sweep that changes no contact velocity by more than this (m/s) ends the iterations early.
 CONVERGED = 1e-9
-
-
-@dataclass
-class ContactBatch:
-    """Per-contact arrays the solver needs; built once per interval from the narrow phase."""
-
-    a: np.ndarray  # first ball
-    b: np.ndarray  # second ball, or the static row N for a plane
-    normal: np.ndarray  # (K, 3), towards a
-    arm_a: np.ndarray  # (K, 3) centre of a → contact point
-    arm_b: np.ndarray  # (K, 3) centre of b → contact point (zero for planes)
-    inv_mass_a: np.ndarray
-    inv_mass_b: np.ndarray
-    inv_inertia_a: np.ndarray
-    inv_inertia_b: np.ndarray
-    restitution: np.ndarray
-    friction: np.ndarray
-    rolling: np.ndarray  # rolling resistance ρ·r (m): angular impulse per unit normal impulse
-    colours: list[np.ndarray]
-
-    def __len__(self) -> int:
-        return len(self.a)
-
-    def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
-        """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side."""
-        a, b = self.arm_a[idx], self.arm_b[idx]
-        return np.sqrt(np.einsum("ij,ij->i", a, a)), np.sqrt(np.einsum("ij,ij->i", b, b))
-
-    def subset(self, mask: np.ndarray, static: int) -> ContactBatch:
-        """The contacts where ``mask`` holds, coloured afresh."""
-        fields = {k: v[mask] for k, v in vars(self).items() if k != "colours"}
-        return ContactBatch(**fields, colours=colour(fields["a"], fields["b"], static))
 
 
 @dataclass
@@ -71,32 +41,6 @@ class Impulses:
     @staticmethod
     def zeros(count: int) -> Impulses:
         return Impulses(np.zeros(count), np.zeros((count, 3)), np.zeros((count, 3)))
-
-
-def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
-    """Split contacts into groups in which no ball appears twice (the static row may repeat).
-
-    Each round takes every contact whose priority is the lowest among the contacts on both its balls
-    (Luby's independent sets); priorities are a fixed hash of the index, so colouring is deterministic.
-    """
-    remaining = np.arange(len(a))
-    priority = (remaining.astype(np.uint64) * np.uint64(2654435761)) % np.uint64(4294967291)
-    order = np.argsort(priority, kind="stable")
-    rank = np.empty(len(a), np.int64)
-    rank[order] = np.arange(len(a))
-    colours = []
-    lowest = np.empty(static + 1, np.int64)
-    while remaining.size:
-        ra, rb = a[remaining], b[remaining]
-        r = rank[remaining]
-        lowest.fill(len(a))
-        np.minimum.at(lowest, ra, r)
-        dynamic_b = rb != static
-        np.minimum.at(lowest, rb[dynamic_b], r[dynamic_b])
-        chosen = (lowest[ra] == r) & (~dynamic_b | (lowest[rb] == r))
-        colours.append(remaining[chosen])
-        remaining = remaining[~chosen]
-    return colours
 
 
 def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
@@ -125,16 +69,16 @@ class _Colour:
     Δω_a = −ρ_a·I_a⁻¹·(n × P), Δω_b = −ρ_b·I_b⁻¹·(n × P).
     """
 
-    def __init__(self, batch: ContactBatch, idx: np.ndarray, local: np.ndarray) -> None:
+    def __init__(self, contacts: ContactRows, idx: np.ndarray, local: np.ndarray) -> None:
         k = len(idx)
         self.idx = idx
-        self.rows = local[np.concatenate((idx, idx + len(batch)))]
-        self.n = batch.normal[idx]
+        self.rows = local[np.concatenate((idx, idx + len(contacts)))]
+        self.n = contacts.normal[idx]
         self.nx = skew(self.n)
-        ra, rb = batch.arm_lengths(idx)
+        ra, rb = contacts.arm_lengths(idx)
         self.ra, self.rb = ra[:, None], rb[:, None]
-        ima, imb = batch.inv_mass_a[idx], batch.inv_mass_b[idx]
-        iia, iib = batch.inv_inertia_a[idx], batch.inv_inertia_b[idx]
+        ima, imb = contacts.inv_mass_a[idx], contacts.inv_mass_b[idx]
+        iia, iib = contacts.inv_inertia_a[idx], contacts.inv_inertia_b[idx]
         inv_m_n = ima + imb
         self.m_n = 1.0 / inv_m_n
         inv_m_t = ima + ra**2 * iia + imb + rb**2 * iib
@@ -147,24 +91,24 @@ class _Colour:
         # Bounds on how much a unit of impulse changes a contact's velocity, for the convergence test.
         self.max_inv_m_n = float(inv_m_n.max())
         self.max_inv_m_t = float(inv_m_t.max())
-        self.mu = batch.friction[idx]
-        self.rolling = batch.rolling[idx]
+        self.mu = contacts.friction[idx]
+        self.rolling = contacts.rolling[idx]
         self.has_friction = bool(self.mu.any())
         self.has_rolling = bool(self.rolling.any())
 
 
-def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
+def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
     """Apply impulses carried over from the previous interval before iterating."""
-    if len(batch) == 0:
+    if len(contacts) == 0:
         return
-    n = batch.normal
+    n = contacts.normal
     linear = imp.normal[:, None] * n + imp.friction
     turn = np.einsum("kij,kj->ki", skew(n), imp.friction)  # n × P_t
-    ra, rb = batch.arm_lengths()
+    ra, rb = contacts.arm_lengths()
     rows = len(v)
     for body, sign, im, ii, r in (
-        (batch.a, 1.0, batch.inv_mass_a, batch.inv_inertia_a, ra),
-        (batch.b, -1.0, batch.inv_mass_b, batch.inv_inertia_b, rb),
+        (contacts.a, 1.0, contacts.inv_mass_a, contacts.inv_inertia_a, ra),
+        (contacts.b, -1.0, contacts.inv_mass_b, contacts.inv_inertia_b, rb),
     ):
         dv = sign * linear * im[:, None]
         dw = (-r[:, None] * turn + sign * imp.rolling) * ii[:, None]
@@ -176,7 +120,7 @@ def warm_start(batch: ContactBatch, v: np.ndarray, w: np.ndarray, imp: Impulses)
 
 
 def solve(
-    batch: ContactBatch,
+    contacts: ContactRows,
     v: np.ndarray,
     w: np.ndarray,
     target: np.ndarray,
@@ -185,13 +129,13 @@ def solve(
 ) -> Impulses:
     """Projected Gauss–Seidel: drive every contact's normal speed to ≥ ``target`` with friction and
     rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates."""
-    if len(batch) == 0:
+    if len(contacts) == 0:
         return imp
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
-    balls, local = np.unique(np.concatenate((batch.a, batch.b)), return_inverse=True)
+    balls, local = np.unique(np.concatenate((contacts.a, contacts.b)), return_inverse=True)
     vw = np.hstack((v[balls], w[balls]))
-    colours = [_Colour(batch, idx, local) for idx in batch.colours]
+    colours = [_Colour(contacts, idx, local) for idx in contacts.colours]
     targets = [target[c.idx] for c in colours]
     normal = [imp.normal[c.idx] for c in colours]
     friction = [imp.friction[c.idx] for c in colours]

@@ -1,11 +1,13 @@
-"""Structure-of-arrays storage for balls and planes.
+"""The state: what a step advances (each ball's position, velocity, orientation and spin, and the
+time), kept apart from the model (``model.py``), what a step only reads.
 
-Arrays are allocated with spare capacity that doubles when full, so adding balls one at a time is
-amortised O(1). The live part of each array is its first ``count`` rows.
+Storage is structure-of-arrays (``Columns``): arrays allocated with spare capacity that doubles when
+full, so adding balls one at a time is amortised O(1). The live part of each array is its first
+``count`` rows.
 
 The ball's dynamic state is one (capacity, 13) block, ``[x(3) v(3) q(4) ω(3)]``, so an integrator
-combines whole states with a handful of array operations; ``x``, ``v``, ``q`` and ``w`` are column views
-into it.
+combines whole states with a handful of array operations; ``X``, ``V``, ``Q`` and ``W`` are its column
+slices.
 """
 
 from __future__ import annotations
@@ -54,38 +56,32 @@ class Columns:
         return arrays[name][: self.count]
 
 
-def sphere_columns() -> Columns:
-    """Per-ball arrays: dynamic state, shape, mass properties and material."""
-    f = float
-    return Columns(
-        {
-            "state": ((STATE_WIDTH,), f),
-            "radius": ((), f),
-            "mass": ((), f),
-            "inv_mass": ((), f),
-            "inv_inertia": ((), f),  # spheres are isotropic: I⁻¹ is a scalar times the identity
-            "restitution": ((), f),
-            "friction": ((), f),
-            "rolling_friction": ((), f),
-            "hollow": ((), bool),
-        }
-    )
+class State:
+    """What a step advances: the (N, 13) block ``[x v q ω]`` of every ball, and the world time (s)."""
+
+    def __init__(self) -> None:
+        self._rows = Columns({"body": ((STATE_WIDTH,), float)})
+        self.time = 0.0
+
+    @property
+    def body(self) -> np.ndarray:
+        """The live (N, 13) state block; its columns are ``X``, ``V``, ``Q`` and ``W``."""
+        return self._rows.body
+
+    @property
+    def count(self) -> int:
+        return self._rows.count
+
+    @property
+    def capacity(self) -> int:
+        return self._rows.capacity
+
+    def reserve(self, extra: int) -> np.ndarray:
+        """Room for ``extra`` more balls; returns their rows of the block, to be filled in."""
+        rows = self._rows.reserve(extra)
+        return self._rows.full("body")[rows]
 
 
-def plane_columns() -> Columns:
-    """Per-plane arrays: frame, half extents (inf for unbounded) and material."""
-    f = float
-    return Columns(
-        {
-            "center": ((3,), f),
-            "orientation": ((4,), f),
-            "normal": ((3,), f),  # the plane's +y axis
-            "axis_u": ((3,), f),  # width direction, the plane's +x axis
-            "axis_v": ((3,), f),  # depth direction, the plane's +z axis
-            "half_size": ((2,), f),
-            "restitution": ((), f),
-            "friction": ((), f),
-            "rolling_friction": ((), f),
-        },
-        capacity=4,
-    )
+def with_static(rows: np.ndarray) -> np.ndarray:
+    """Per-ball rows with the static world's zero row N appended (planes are body N in the solver)."""
+    return np.vstack((rows, np.zeros(rows.shape[1])))

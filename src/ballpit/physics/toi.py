@@ -1,4 +1,4 @@
-"""Time of impact by conservative advancement, vectorised over candidate pairs.
+"""Time of impact by conservative advancement, vectorised over the kept pairs.
 
 For each pair, φ(t) is the gap (distance minus radii) along the path the integrator will take. The
 gap cannot shrink faster than the bound L on the pair's relative speed over the interval, so stepping
@@ -13,6 +13,16 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+
+from . import collision
+from .contacts import SPHERE_PLANE, ContactPoints
+from .model import Model
+from .pairs import CONTACT_SLOP
+from .state import State, V, X, with_static
+
+# Impacts whose times are this close (as an overlap, in radii) are resolved together: a pile of 1,000
+# balls landing then takes ~4 intervals per step instead of ~19. A lone impact is still met exactly.
+IMPACT_OVERLAP = 0.005
 
 
 def first_contact(
@@ -47,3 +57,51 @@ def first_contact(
         gap = gap_at(active, t_next)
     when[active] = t[active]
     return when
+
+
+def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float) -> float:
+    """Time until the first pair not yet touching comes into contact (inf if none within ``h``).
+
+    Each ball follows the integrator's path under ``accel`` (its free acceleration plus the resting
+    forces). Impacts close in time are taken together: the result is the latest impact that leaves
+    every earlier pair overlapping by less than IMPACT_OVERLAP of the smallest radius (removed next
+    interval by moving positions). A lone impact is always met exactly.
+    """
+    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+    if apart.size == 0:
+        return np.inf
+    body, path = state.body, model.integrator
+    x, v = with_static(body[:, X]), with_static(body[:, V])
+    acc = path.path_acceleration(with_static(accel))
+    a, b = c.a[apart], c.b[apart]
+    bound = path.closing_speed_bound(v[a] - v[b], acc[a] - acc[b], h)
+    reachable = c.gap[apart] <= bound * h
+    apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
+    if apart.size == 0:
+        return np.inf
+    on_plane = c.kind[apart] == SPHERE_PLANE
+    radius = np.append(model.spheres.radius, 0.0)
+    reach = radius[a] + radius[b]
+    pl = model.planes
+
+    def gap_at(k: np.ndarray, t: np.ndarray) -> np.ndarray:
+        tt = t[:, None]
+        pa = x[a[k]] + v[a[k]] * tt + 0.5 * acc[a[k]] * tt * tt
+        pb = x[b[k]] + v[b[k]] * tt + 0.5 * acc[b[k]] * tt * tt
+        plane_k = on_plane[k]
+        if plane_k.any():
+            pk = c.other[apart[k[plane_k]]]
+            pb[plane_k] = collision.closest_point_on_planes(
+                pa[plane_k], pk, pl.center, pl.axis_u, pl.axis_v, pl.half_size
+            )
+        return np.linalg.norm(pa - pb, axis=1) - reach[k]
+
+    when = first_contact(gap_at, bound, h, 0.5 * CONTACT_SLOP)
+    hit = np.isfinite(when)
+    if not hit.any():
+        return np.inf
+    order = np.argsort(when[hit], kind="stable")
+    t, speed = when[hit][order], bound[hit][order]
+    overlap = (t - t[0]) * np.maximum.accumulate(speed)
+    allowed = IMPACT_OVERLAP * float(model.spheres.radius.min())
+    return float(t[np.searchsorted(overlap, allowed, side="right") - 1])

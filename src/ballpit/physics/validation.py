@@ -92,3 +92,24 @@ def array_of(name: str, value: object, count: int, width: int | None) -> np.ndar
         bad = arr[~np.isfinite(arr)].ravel()[0]
         raise ValueError(f"{name} must be finite, got {bad!r}")
     return arr
+
+
+# Column ranges of a ball's state row [x v q ω], for naming what went non-finite.
+_STATE_FIELDS = (("position", 0, 3), ("velocity", 3, 6), ("orientation", 6, 10), ("angular_velocity", 10, 13))
+
+
+def reject_non_finite_state(body: np.ndarray) -> None:
+    """Refuse to step from a NaN/inf written straight into the arrays (the setters check theirs)."""
+    if np.isfinite(body).all():
+        return
+    row, col = np.argwhere(~np.isfinite(body))[0]
+    field = next(name for name, start, stop in _STATE_FIELDS if start <= col < stop)
+    raise ValueError(f"sphere #{row} has a non-finite {field} ({body[row, col]}); the world was not stepped")
+
+
+def undo_non_finite_step(body: np.ndarray, before: np.ndarray) -> None:
+    """Keep the world free of NaN/inf: restore the state and raise if a step produced any."""
+    if not np.isfinite(body).all():
+        bad = int(np.flatnonzero(~np.isfinite(body).all(axis=1))[0])
+        body[:] = before
+        raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")

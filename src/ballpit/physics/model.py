@@ -1,0 +1,126 @@
+"""The model: what a step reads but never changes.
+
+Ball properties (radius, mass, inertia, material), plane shapes and materials, and the world's
+parameters (gravity, drag, integrator, solver settings). The state a step advances is in ``state.py``;
+together they are everything a World is (NVIDIA warp.sim's Model/State split).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import quaternion
+from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
+from .integrators import INTEGRATORS, Integrator
+from .state import Columns
+
+# Moments of inertia of a sphere about a diameter, as a fraction of m·r².
+SOLID_INERTIA = 2.0 / 5.0
+HOLLOW_INERTIA = 2.0 / 3.0
+# A step in which more than this many pairs not yet touching may meet is taken whole, with
+# speculative contacts (see strategies.py).
+CROWD_LIMIT = 32
+# Projected Gauss–Seidel sweeps per solve.
+SOLVER_ITERATIONS = 10
+
+
+def sphere_columns() -> Columns:
+    """Per-ball properties: shape, mass properties and material."""
+    f = float
+    return Columns(
+        {
+            "radius": ((), f),
+            "mass": ((), f),
+            "inv_mass": ((), f),
+            "inv_inertia": ((), f),  # spheres are isotropic: I⁻¹ is a scalar times the identity
+            "restitution": ((), f),
+            "friction": ((), f),
+            "rolling_friction": ((), f),
+            "hollow": ((), bool),
+        }
+    )
+
+
+def plane_columns() -> Columns:
+    """Per-plane arrays: frame, half extents (inf for unbounded) and material."""
+    f = float
+    return Columns(
+        {
+            "center": ((3,), f),
+            "orientation": ((4,), f),
+            "normal": ((3,), f),  # the plane's +y axis
+            "axis_u": ((3,), f),  # width direction, the plane's +x axis
+            "axis_v": ((3,), f),  # depth direction, the plane's +z axis
+            "half_size": ((2,), f),
+            "restitution": ((), f),
+            "friction": ((), f),
+            "rolling_friction": ((), f),
+        },
+        capacity=4,
+    )
+
+
+class Model:
+    """Ball properties, planes and parameters. The World's setters validate what is written here."""
+
+    def __init__(self) -> None:
+        self.spheres = sphere_columns()
+        self.planes = plane_columns()
+        self.gravity = np.array([0.0, -9.81, 0.0])
+        self.integrator: Integrator = INTEGRATORS["rk4"]
+        self.linear_drag = 0.0
+        self.angular_drag = 0.0
+        self.restitution_threshold: float | None = None
+        self.solver_iterations = SOLVER_ITERATIONS
+        self.crowd_limit: float = CROWD_LIMIT
+
+    def append_spheres(self, n: int, *, radius, mass, restitution, friction, rolling_friction,
+                       hollow) -> slice:  # fmt: skip
+        """Room for ``n`` more balls with these (validated, broadcastable) properties; their rows."""
+        cols = self.spheres
+        rows = cols.reserve(n)
+        cols.full("radius")[rows] = radius
+        cols.full("mass")[rows] = mass
+        cols.full("inv_mass")[rows] = 1.0 / np.asarray(mass)
+        shape_factor = np.where(hollow, HOLLOW_INERTIA, SOLID_INERTIA)
+        cols.full("inv_inertia")[rows] = 1.0 / (shape_factor * np.asarray(mass) * np.asarray(radius) ** 2)
+        cols.full("hollow")[rows] = hollow
+        cols.full("restitution")[rows] = restitution
+        cols.full("friction")[rows] = friction
+        cols.full("rolling_friction")[rows] = rolling_friction
+        return rows
+
+    def append_plane(self, center: np.ndarray, q: np.ndarray, half_size: tuple[float, float],
+                     materials: dict[str, float]) -> int:  # fmt: skip
+        """One more plane: centre, orientation (turning +y to its normal), half extents, materials."""
+        cols = self.planes
+        i = cols.reserve(1).start
+        axes = quaternion.rotate(q, np.eye(3))  # rows: the plane's x, y (normal) and z axes
+        cols.full("center")[i] = center
+        cols.full("orientation")[i] = q
+        cols.full("axis_u")[i] = axes[0]
+        cols.full("normal")[i] = axes[1] / np.linalg.norm(axes[1])
+        cols.full("axis_v")[i] = axes[2]
+        cols.full("half_size")[i] = half_size
+        for key, value in materials.items():
+            cols.full(key)[i] = value
+        return i
+
+    def forces(self) -> list[ForceTerm]:
+        """The force terms acting on every ball: gravity, then the drags that are switched on."""
+        terms: list[ForceTerm] = [Gravity(self.gravity)]
+        if self.linear_drag:
+            terms.append(LinearDrag(self.linear_drag))
+        if self.angular_drag:
+            terms.append(AngularDrag(self.angular_drag))
+        return terms
+
+    def bounce_threshold(self, dt: float) -> float:
+        """The approach speed below which contacts do not bounce.
+
+        Default: the integrator's ``threshold_steps``·|g|·dt (2 for RK2 and RK4: a ball bouncing slower
+        than 2·|g|·dt would land again within a step or two; 8 for explicit Euler, see integrators.py).
+        """
+        if self.restitution_threshold is not None:
+            return self.restitution_threshold
+        return self.integrator.threshold_steps * float(np.linalg.norm(self.gravity)) * dt

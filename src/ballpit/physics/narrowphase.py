@@ -1,0 +1,35 @@
+"""Narrow phase: every kept pair measured at the current positions (gap, normal and point).
+
+The geometry itself (sphere–rectangle with faces, edges and corners; sphere–sphere) is in
+``collision.py``; this stage gathers it for the kept pairs into one ``ContactPoints``, sphere–plane
+pairs first. A plane's contacts name the static row N as their second body, so the solver treats a
+plane as a ball that never moves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import collision
+from .contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints
+from .model import Model
+from .pairs import KeptPairs
+from .state import State, X
+
+
+def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoints:
+    """Gap, normal and point of every kept pair at the current positions."""
+    x, radius = state.body[:, X], model.spheres.radius
+    c = pairs
+    gp, np_, pp = collision.sphere_plane(x, radius, c.sphere, c.plane, c.side, model.planes)
+    gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
+    static = np.full(len(c.sphere), model.spheres.count)
+    return ContactPoints(
+        kind=np.concatenate((np.full(len(gp), SPHERE_PLANE), np.full(len(gs), SPHERE_SPHERE))),
+        a=np.concatenate((c.sphere, c.pair_i)),
+        b=np.concatenate((static, c.pair_j)),
+        other=np.concatenate((c.plane, c.pair_j)),
+        gap=np.concatenate((gp, gs)),
+        normal=np.concatenate((np_, ns)),
+        point=np.concatenate((pp, ps)),
+    )

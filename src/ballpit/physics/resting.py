@@ -1,0 +1,85 @@
+"""The resting solve: constant contact forces over an interval that leave every touching contact not
+approaching and not slipping beyond the friction cone at the interval's end.
+
+Solving for end-of-interval velocities and applying the impulses as constant forces keeps the
+integrators exact: a resting ball's force cancels gravity, so it reports zero velocity.
+
+The solve is warm-started from the forces of the last interval, looked up by each pair's own identity
+(``contacts.pair_keys``), so a contact never picks up another pair's force when balls are added.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import solver
+from .contacts import ContactPoints, EventLog
+from .forces import ConstantPerBall
+from .model import Model
+from .rows import ContactRows
+from .solver import Impulses
+from .state import State, V, W, with_static
+
+# Resting forces found over less than this fraction of a step do not warm-start the next solve.
+WARM_START_SPAN = 0.5
+
+
+class WarmStart:
+    """Last interval's resting forces (N, N·s/s per unit time), sorted by pair key."""
+
+    def __init__(self) -> None:
+        self.keys = np.zeros(0, np.int64)
+        self.forces = Impulses.zeros(0)
+
+    def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
+        """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""
+        imp = Impulses.zeros(len(keys))
+        if len(self.keys) == 0:
+            return imp
+        pos = np.searchsorted(self.keys, keys)
+        pos = np.minimum(pos, len(self.keys) - 1)
+        found = self.keys[pos] == keys
+        src = pos[found]
+        imp.normal[found] = self.forces.normal[src] * h
+        friction = self.forces.friction[src] * h
+        n = normal[found]
+        imp.friction[found] = (
+            friction - np.einsum("ij,ij->i", friction, n)[:, None] * n
+        )  # onto today's tangent plane
+        imp.rolling[found] = self.forces.rolling[src] * h
+        return imp
+
+    def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> None:
+        """Remember the impulses found over ``h`` as forces, for the next solve."""
+        order = np.argsort(keys)
+        self.keys = keys[order]
+        parts = (imp.normal, imp.friction, imp.rolling)
+        self.forces = Impulses(*(part[order] / h for part in parts))
+
+
+def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,
+                   ang: np.ndarray, h: float, dt: float, target: np.ndarray, warm: WarmStart,
+                   events: EventLog, now: float) -> ConstantPerBall | None:  # fmt: skip
+    """Constant contact forces over the next ``h`` seconds that leave each contact's normal speed at
+    least ``target`` (0 for a touching contact, −gap/dt for a speculative one) at the interval's end.
+
+    ``lin`` and ``ang`` are the free accelerations. The forces warm-start the next solve only when
+    ``h`` is at least WARM_START_SPAN of the step ``dt``: the force that stops a slow arrival in the last
+    sliver of a step is no force to hold for the next whole step. Warm-started with it, a column of
+    balls is pre-stressed: the impulses cancel ball by ball, so the sweeps see nothing to correct until
+    the stress reaches the top.
+    """
+    if len(c) == 0:
+        return None
+    v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
+    v[:-1] += lin * h
+    w[:-1] += ang * h
+    v_free, w_free = v.copy(), w.copy()
+    keys = c.keys()
+    imp = warm.impulses(keys, c.normal, h)
+    solver.warm_start(rows, v, w, imp)
+    solver.solve(rows, v, w, target, imp, model.solver_iterations)
+    if h >= WARM_START_SPAN * dt:
+        warm.keep(keys, imp, h)
+    events.add_resting(now, c, keys, imp.normal)
+    return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)

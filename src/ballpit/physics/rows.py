@@ -1,0 +1,108 @@
+"""Contact rows: what the solver needs of each touching (or speculative) contact, built once per
+interval: both bodies' inverse masses and inertias, the lever arms, the mixed materials, and the
+colours that let contacts sharing no ball be solved together.
+
+Material mixing (design.md): restitution e = e_a·e_b, friction μ = sqrt(μ_a·μ_b), rolling friction
+ρ = sqrt(ρ_a·ρ_b). Balls are rows 0…N−1; row N is the static world (planes), with zero inverse mass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contacts import SPHERE_PLANE, ContactPoints
+from .model import Model
+
+
+@dataclass
+class ContactRows:
+    """Per-contact arrays the solver needs; built once per interval from the contact points."""
+
+    a: np.ndarray  # first ball
+    b: np.ndarray  # second ball, or the static row N for a plane
+    normal: np.ndarray  # (K, 3), towards a
+    arm_a: np.ndarray  # (K, 3) centre of a → contact point
+    arm_b: np.ndarray  # (K, 3) centre of b → contact point (zero for planes)
+    inv_mass_a: np.ndarray
+    inv_mass_b: np.ndarray
+    inv_inertia_a: np.ndarray
+    inv_inertia_b: np.ndarray
+    restitution: np.ndarray
+    friction: np.ndarray
+    rolling: np.ndarray  # rolling resistance ρ·r (m): angular impulse per unit normal impulse
+    colours: list[np.ndarray]
+
+    def __len__(self) -> int:
+        return len(self.a)
+
+    def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side."""
+        a, b = self.arm_a[idx], self.arm_b[idx]
+        return np.sqrt(np.einsum("ij,ij->i", a, a)), np.sqrt(np.einsum("ij,ij->i", b, b))
+
+    def subset(self, mask: np.ndarray, static: int) -> ContactRows:
+        """The contacts where ``mask`` holds, coloured afresh."""
+        fields = {k: v[mask] for k, v in vars(self).items() if k != "colours"}
+        return ContactRows(**fields, colours=colour(fields["a"], fields["b"], static))
+
+
+def contact_rows(model: Model, c: ContactPoints) -> ContactRows:
+    """Masses, lever arms and mixed materials of the contacts ``c``, grouped into colours."""
+    sph, pl = model.spheres, model.planes
+    with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
+    radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
+    on_plane = c.kind == SPHERE_PLANE
+    p = np.where(on_plane, c.other, 0)
+    o = np.where(on_plane, 0, c.other)
+
+    def mixed(ball: np.ndarray, plane: np.ndarray, rule) -> np.ndarray:
+        other = np.where(on_plane, plane[p] if len(plane) else 0.0, ball[o])
+        return rule(ball[c.a], other)
+
+    ra, rb = radius[c.a], radius[c.b]
+    # Rolling resistance acts through the rolling radius: r for a ball on a plane, the reduced
+    # radius 2·r_a·r_b/(r_a + r_b) between two balls.
+    roll_radius = np.where(on_plane, ra, 2.0 * ra * rb / np.where(on_plane, 1.0, ra + rb))
+    return ContactRows(
+        a=c.a,
+        b=c.b,
+        normal=c.normal,
+        arm_a=-ra[:, None] * c.normal,
+        arm_b=rb[:, None] * c.normal,
+        inv_mass_a=inv_mass[c.a],
+        inv_mass_b=inv_mass[c.b],
+        inv_inertia_a=inv_inertia[c.a],
+        inv_inertia_b=inv_inertia[c.b],
+        restitution=mixed(sph.restitution, pl.restitution, np.multiply),
+        friction=np.sqrt(mixed(sph.friction, pl.friction, np.multiply)),
+        rolling=np.sqrt(mixed(sph.rolling_friction, pl.rolling_friction, np.multiply)) * roll_radius,
+        colours=colour(c.a, c.b, sph.count),
+    )
+
+
+def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
+    """Split contacts into groups in which no ball appears twice (the static row may repeat).
+
+    Each round takes every contact whose priority is the lowest among the contacts on both its balls
+    (Luby's independent sets); priorities are a fixed hash of the index, so colouring is deterministic.
+    """
+    remaining = np.arange(len(a))
+    priority = (remaining.astype(np.uint64) * np.uint64(2654435761)) % np.uint64(4294967291)
+    order = np.argsort(priority, kind="stable")
+    rank = np.empty(len(a), np.int64)
+    rank[order] = np.arange(len(a))
+    colours = []
+    lowest = np.empty(static + 1, np.int64)
+    while remaining.size:
+        ra, rb = a[remaining], b[remaining]
+        r = rank[remaining]
+        lowest.fill(len(a))
+        np.minimum.at(lowest, ra, r)
+        dynamic_b = rb != static
+        np.minimum.at(lowest, rb[dynamic_b], r[dynamic_b])
+        chosen = (lowest[ra] == r) & (~dynamic_b | (lowest[rb] == r))
+        colours.append(remaining[chosen])
+        remaining = remaining[~chosen]
+    return colours
