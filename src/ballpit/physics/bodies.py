@@ -44,14 +44,20 @@ def _material(name: str, owner: str):
     return property(get, set, doc=f"The {owner}'s {name.replace('_', ' ')} coefficient.")
 
 
-class Sphere:
-    """A ball: a live view of row ``index`` of the world's sphere arrays."""
+class _Body:
+    """A live view: the world and a row index, nothing else, so it never goes stale."""
 
     __slots__ = ("_world", "index")
 
     def __init__(self, world: World, index: int) -> None:
         self._world = world
         self.index = index
+
+
+class Sphere(_Body):
+    """A ball: a live view of row ``index`` of the world's sphere arrays."""
+
+    __slots__ = ()
 
     @property
     def _columns(self) -> Columns:
@@ -87,14 +93,10 @@ class Sphere:
         return f"Sphere(index={self.index}, position=({x:.4g}, {y:.4g}, {z:.4g}), radius={self.radius:g})"
 
 
-class Plane:
+class Plane(_Body):
     """A plane or finite rectangle: a live view of row ``index`` of the world's plane arrays."""
 
-    __slots__ = ("_world", "index")
-
-    def __init__(self, world: World, index: int) -> None:
-        self._world = world
-        self.index = index
+    __slots__ = ()
 
     @property
     def _columns(self) -> Columns:
@@ -172,6 +174,14 @@ def _read_only(column: np.ndarray) -> np.ndarray:
     return view
 
 
+def _state_column(cols: slice, doc: str) -> property:
+    return property(lambda self: self._world.state.body[:, cols], doc=doc)
+
+
+def _plane_column(name: str, doc: str) -> property:
+    return property(lambda self: getattr(self._world.model.planes, name), doc=doc)
+
+
 class _Views(Sequence):
     _view: type
 
@@ -211,21 +221,10 @@ class SphereList(_Views):
     def _count(self) -> int:
         return self._world.state.count
 
-    @property
-    def positions(self) -> np.ndarray:
-        return self._world.state.body[:, X]
-
-    @property
-    def velocities(self) -> np.ndarray:
-        return self._world.state.body[:, V]
-
-    @property
-    def orientations(self) -> np.ndarray:
-        return self._world.state.body[:, Q]
-
-    @property
-    def angular_velocities(self) -> np.ndarray:
-        return self._world.state.body[:, W]
+    positions = _state_column(X, "Every ball's position (m).")
+    velocities = _state_column(V, "Every ball's velocity (m/s).")
+    orientations = _state_column(Q, "Every ball's orientation quaternion (x, y, z, w).")
+    angular_velocities = _state_column(W, "Every ball's angular velocity (rad/s, world frame).")
 
     @property
     def radii(self) -> np.ndarray:
@@ -246,22 +245,8 @@ class PlaneList(_Views):
     def _count(self) -> int:
         return self._world.model.planes.count
 
-    @property
-    def centers(self) -> np.ndarray:
-        return self._world.model.planes.center
-
-    @property
-    def normals(self) -> np.ndarray:
-        return self._world.model.planes.normal
-
-    @property
-    def orientations(self) -> np.ndarray:
-        return self._world.model.planes.orientation
-
-    @property
-    def half_sizes(self) -> np.ndarray:
-        return self._world.model.planes.half_size
-
-    @property
-    def restitutions(self) -> np.ndarray:
-        return self._world.model.planes.restitution
+    centers = _plane_column("center", "Every plane's centre (m).")
+    normals = _plane_column("normal", "Every plane's unit normal.")
+    orientations = _plane_column("orientation", "Every plane's orientation quaternion (x, y, z, w).")
+    half_sizes = _plane_column("half_size", "Every plane's half width and depth (inf: unbounded).")
+    restitutions = _plane_column("restitution", "Every plane's restitution.")

@@ -17,7 +17,15 @@ from .bodies import Plane, PlaneList, Sphere, SphereList
 from .contacts import ContactRecord, EventLog
 from .forces import ForceTerm, free_acceleration
 from .integrators import INTEGRATORS, Workspace
-from .model import Model
+from .model import (
+    BALL_MASS,
+    BALL_RADIUS,
+    BALL_RESTITUTION,
+    FRICTION,
+    PLANE_RESTITUTION,
+    ROLLING_FRICTION,
+    Model,
+)
 from .pairs import PairCache
 from .profile import StepProfile
 from .resting import WarmStart
@@ -25,6 +33,18 @@ from .state import Q, State, V, W, X
 
 # The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
 DEFAULT_TIMESTEP = 1.0 / 240.0
+
+
+def _model_number(name: str, doc: str, **checks: bool) -> property:
+    """A World parameter stored in the model, validated on the way in."""
+
+    def get(self: World) -> float:
+        return getattr(self.model, name)
+
+    def set(self: World, value: float) -> None:
+        setattr(self.model, name, validation.number(name, value, **checks))
+
+    return property(get, set, doc=doc)
 
 
 class World:
@@ -83,21 +103,10 @@ class World:
             raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {value!r}")
         self.model.integrator = INTEGRATORS[value.lower()]
 
-    @property
-    def linear_drag(self) -> float:
-        return self.model.linear_drag
-
-    @linear_drag.setter
-    def linear_drag(self, value: float) -> None:
-        self.model.linear_drag = validation.number("linear_drag", value, nonnegative=True)
-
-    @property
-    def angular_drag(self) -> float:
-        return self.model.angular_drag
-
-    @angular_drag.setter
-    def angular_drag(self, value: float) -> None:
-        self.model.angular_drag = validation.number("angular_drag", value, nonnegative=True)
+    linear_drag = _model_number("linear_drag", "Linear drag c (1/s): acceleration −c·v.", nonnegative=True)
+    angular_drag = _model_number(
+        "angular_drag", "Angular drag c_ω (1/s): angular acceleration −c_ω·ω.", nonnegative=True
+    )
 
     @property
     def solver_iterations(self) -> int:
@@ -110,15 +119,13 @@ class World:
             raise ValueError(f"solver_iterations must be a whole number of at least 1, got {value!r}")
         self.model.solver_iterations = int(value)
 
-    @property
-    def crowd_limit(self) -> float:
-        """A step in which more pairs than this may meet is taken whole, with speculative contacts
-        (``inf``: always split the step at each impact; 0: take every step with an impact whole)."""
-        return self.model.crowd_limit
-
-    @crowd_limit.setter
-    def crowd_limit(self, value: float) -> None:
-        self.model.crowd_limit = validation.number("crowd_limit", value, nonnegative=True, infinite=True)
+    crowd_limit = _model_number(
+        "crowd_limit",
+        "A step in which more pairs than this may meet is taken whole, with speculative contacts "
+        "(inf: always split the step at each impact; 0: take every step with an impact whole).",
+        nonnegative=True,
+        infinite=True,
+    )
 
     @property
     def restitution_threshold(self) -> float | None:
@@ -143,14 +150,14 @@ class World:
     def add_sphere(
         self,
         position: object = (0.0, 0.0, 0.0),
-        radius: float = 0.5,
-        mass: float = 1.0,
+        radius: float = BALL_RADIUS,
+        mass: float = BALL_MASS,
         velocity: object = (0.0, 0.0, 0.0),
         angular_velocity: object = (0.0, 0.0, 0.0),
         orientation: object = (0.0, 0.0, 0.0, 1.0),
-        restitution: float = 1.0,
-        friction: float = 0.5,
-        rolling_friction: float = 0.0,
+        restitution: float = BALL_RESTITUTION,
+        friction: float = FRICTION,
+        rolling_friction: float = ROLLING_FRICTION,
         hollow: bool = False,
     ) -> Sphere:
         """Add one ball and return its live view."""
@@ -173,14 +180,14 @@ class World:
     def add_spheres(
         self,
         positions: object,
-        radius: object = 0.5,
-        mass: object = 1.0,
+        radius: object = BALL_RADIUS,
+        mass: object = BALL_MASS,
         velocity: object = (0.0, 0.0, 0.0),
         angular_velocity: object = (0.0, 0.0, 0.0),
         orientation: object = (0.0, 0.0, 0.0, 1.0),
-        restitution: object = 1.0,
-        friction: object = 0.5,
-        rolling_friction: object = 0.0,
+        restitution: object = BALL_RESTITUTION,
+        friction: object = FRICTION,
+        rolling_friction: object = ROLLING_FRICTION,
         hollow: object = False,
     ) -> np.ndarray:
         """Add many balls at once; every argument broadcasts against ``positions`` (N, 3).
@@ -235,9 +242,9 @@ class World:
         normal: object = None,
         rotation: object = None,
         size: object = None,
-        restitution: float = 0.8,
-        friction: float = 0.5,
-        rolling_friction: float = 0.0,
+        restitution: float = PLANE_RESTITUTION,
+        friction: float = FRICTION,
+        rolling_friction: float = ROLLING_FRICTION,
     ) -> Plane:
         """Add a static plane: infinite (``size=None``), square (a side) or rectangular ((width, depth)).
 
