@@ -8,6 +8,8 @@ caches that change results: the broad phase's kept pairs (pairs.py) and the warm
 
 from __future__ import annotations
 
+import copy
+from dataclasses import dataclass
 from time import perf_counter
 
 import numpy as np
@@ -33,6 +35,17 @@ from .state import Q, State, V, W, X
 
 # The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
 DEFAULT_TIMESTEP = 1.0 / 240.0
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """Everything a World's future depends on, frozen at one moment (``World.snapshot``)."""
+
+    model: Model
+    state: State
+    pairs: PairCache
+    warm: WarmStart
+    crowded_steps: int
 
 
 def _model_number(name: str, doc: str, **checks: bool) -> property:
@@ -311,6 +324,34 @@ class World:
         prof.total = perf_counter() - began
         self.profile = prof
         return record
+
+    # ------------------------------------------------------------------ snapshots
+    def snapshot(self) -> Snapshot:
+        """A deep copy of everything ``step`` reads or writes: the model (balls, planes, parameters),
+        the state (ball states, time) and the caches that change results (kept pairs, warm start)."""
+        parts = copy.deepcopy((self.model, self.state, self._pairs, self._warm))
+        return Snapshot(*parts, crowded_steps=self.crowded_steps)
+
+    def restore(self, snap: Snapshot) -> None:
+        """Put the world back as it was at ``snap``; stepping on repeats the original run bit for bit.
+
+        The snapshot stays usable: it can be restored again. Live views of balls that did not exist
+        then raise IndexError when read.
+        """
+        if not isinstance(snap, Snapshot):
+            raise TypeError(f"restore takes a Snapshot from World.snapshot(), got {type(snap).__name__}")
+        self.model, self.state, self._pairs, self._warm = copy.deepcopy(
+            (snap.model, snap.state, snap.pairs, snap.warm)
+        )
+        self.crowded_steps = snap.crowded_steps
+
+    def copy(self) -> World:
+        """An independent World in the same state (it steps on exactly as this one would)."""
+        twin = World.__new__(World)
+        twin.profile = StepProfile()
+        twin._workspace = Workspace()
+        twin.restore(self.snapshot())
+        return twin
 
     # ------------------------------------------------------------------ measures
     def kinetic_energy(self) -> float:
