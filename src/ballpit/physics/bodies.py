@@ -44,6 +44,27 @@ def _material(name: str, owner: str):
     return property(get, set, doc=f"The {owner}'s {name.replace('_', ' ')} coefficient.")
 
 
+def _state_column(cols: slice, doc: str) -> property:
+    return property(lambda self: self._world.state.body[:, cols], doc=doc)
+
+
+def _plane_column(name: str, doc: str, pose: bool = False) -> property:
+    def get(self: PlaneList) -> np.ndarray:
+        return getattr(self._world.state.planes if pose else self._world.model.planes, name)
+
+    return property(get, doc=doc)
+
+
+def _plane_motion(name: str, doc: str) -> property:
+    def get(self: Plane) -> np.ndarray:
+        return getattr(self._columns, name)[self.index]
+
+    def set(self: Plane, value: object) -> None:
+        getattr(self._columns, name)[self.index] = validation.vector(name, value)
+
+    return property(get, set, doc=doc)
+
+
 class _Body:
     """A live view: the world and a row index, nothing else, so it never goes stale."""
 
@@ -107,22 +128,33 @@ class Plane(_Body):
     rolling_friction = _material("rolling_friction", "plane")
 
     @property
+    def _pose(self) -> Columns:
+        return self._world.state.planes
+
+    velocity = _plane_motion("velocity", "The velocity (m/s, world frame) the plane moves with.")
+    angular_velocity = _plane_motion(
+        "angular_velocity",
+        "The angular velocity (rad/s, world frame) the plane turns with, about its centre.",
+    )
+
+    @property
     def position(self) -> np.ndarray:
-        return self._columns.center[self.index]
+        """Where the plane's centre is now (a step moves it by its velocity)."""
+        return self._pose.center[self.index]
 
     @property
     def normal(self) -> np.ndarray:
-        return self._columns.normal[self.index]
+        return self._pose.normal[self.index]
 
     @property
     def orientation(self) -> np.ndarray:
         """The rotation taking the +y plane to this one, (x, y, z, w)."""
-        return self._columns.orientation[self.index]
+        return self._pose.orientation[self.index]
 
     @property
     def axes(self) -> tuple[np.ndarray, np.ndarray]:
         """The in-plane width (+x turned) and depth (+z turned) directions."""
-        return self._columns.axis_u[self.index], self._columns.axis_v[self.index]
+        return self._pose.axis_u[self.index], self._pose.axis_v[self.index]
 
     @property
     def size(self) -> tuple[float, float] | None:
@@ -137,9 +169,9 @@ class Plane(_Body):
         return bool(np.isinf(self._columns.half_size[self.index]).all())
 
     def _frame(self) -> tuple[np.ndarray, ...]:
-        c = self._columns
+        pose = self._pose
         i = slice(self.index, self.index + 1)
-        return c.center[i], c.normal[i], c.axis_u[i], c.axis_v[i], c.half_size[i]
+        return pose.center[i], pose.normal[i], pose.axis_u[i], pose.axis_v[i], self._columns.half_size[i]
 
     def signed_distance(self, points: object) -> np.ndarray | float:
         """Signed distance of points from the plane's infinite extension, positive on the normal's side."""
@@ -172,14 +204,6 @@ def _read_only(column: np.ndarray) -> np.ndarray:
     view = column.view()
     view.flags.writeable = False
     return view
-
-
-def _state_column(cols: slice, doc: str) -> property:
-    return property(lambda self: self._world.state.body[:, cols], doc=doc)
-
-
-def _plane_column(name: str, doc: str) -> property:
-    return property(lambda self: getattr(self._world.model.planes, name), doc=doc)
 
 
 class _Views(Sequence):
@@ -245,8 +269,12 @@ class PlaneList(_Views):
     def _count(self) -> int:
         return self._world.model.planes.count
 
-    centers = _plane_column("center", "Every plane's centre (m).")
-    normals = _plane_column("normal", "Every plane's unit normal.")
-    orientations = _plane_column("orientation", "Every plane's orientation quaternion (x, y, z, w).")
+    centers = _plane_column("center", "Every plane's centre (m), where it is now.", pose=True)
+    normals = _plane_column("normal", "Every plane's unit normal.", pose=True)
+    orientations = _plane_column(
+        "orientation", "Every plane's orientation quaternion (x, y, z, w).", pose=True
+    )
+    velocities = _plane_column("velocity", "Every plane's velocity (m/s).")
+    angular_velocities = _plane_column("angular_velocity", "Every plane's angular velocity (rad/s).")
     half_sizes = _plane_column("half_size", "Every plane's half width and depth (inf: unbounded).")
     restitutions = _plane_column("restitution", "Every plane's restitution.")

@@ -111,8 +111,13 @@ def sphere_plane_pairs(
     axis_u: np.ndarray,
     axis_v: np.ndarray,
     half_size: np.ndarray,
+    sweep=None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs (sphere, plane) whose box reaches the plane's rectangle."""
+    """Pairs (sphere, plane) whose box reaches the plane's rectangle.
+
+    ``sweep(p, d)``, when given, is how far a point of plane ``p`` at distance ``d`` from its centre
+    may move (a moving plane); a box that close counts too.
+    """
     box_center = 0.5 * (lo + hi)
     box_radius = 0.5 * np.linalg.norm(hi - lo, axis=1)
     spheres, planes = [], []
@@ -123,7 +128,11 @@ def sphere_plane_pairs(
         dn = d @ normal[p]
         # distance from the box centre to the rectangle, against the box's bounding-sphere radius
         dist2 = np.maximum(du, 0.0) ** 2 + np.maximum(dv, 0.0) ** 2 + dn**2
-        hit = np.flatnonzero(dist2 <= box_radius**2)
+        if sweep is None:
+            hit = np.flatnonzero(dist2 <= box_radius**2)
+        else:
+            grown = box_radius + sweep(p, np.linalg.norm(d, axis=1) + box_radius)
+            hit = np.flatnonzero(dist2 <= grown**2)
         spheres.append(hit)
         planes.append(np.full(len(hit), p))
     if not spheres:

@@ -35,19 +35,24 @@ def sphere_plane(
     sphere: np.ndarray,
     plane: np.ndarray,
     side: np.ndarray,
-    planes,
+    center: np.ndarray,
+    normal: np.ndarray,
+    axis_u: np.ndarray,
+    axis_v: np.ndarray,
+    half_size: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Gap, unit normal (towards the ball) and contact point for each (sphere, plane) pair.
+    """Gap, unit normal (towards the ball) and contact point for each (sphere, plane) pair, with the
+    planes' frames given by their centre, normal, axes and half extents.
 
     ``side`` (±1) is the side of the plane each ball started the step on. A ball whose centre has
     crossed the face (which continuous detection prevents, but an edited scene can cause) is pushed back
     to the side it came from instead of through.
     """
     p = x[sphere]
-    point = closest_point_on_planes(p, plane, planes.center, planes.axis_u, planes.axis_v, planes.half_size)
+    point = closest_point_on_planes(p, plane, center, axis_u, axis_v, half_size)
     delta = p - point
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
-    plane_normal = planes.normal[plane]
+    plane_normal = normal[plane]
     signed = np.einsum("ij,ij->i", delta, plane_normal)
     in_plane = dist - np.abs(signed)  # zero when the closest point is on the face, not an edge or corner
     on_face = in_plane <= 1e-12 * np.maximum(dist, 1.0)

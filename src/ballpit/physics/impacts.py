@@ -37,6 +37,8 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
     ra, rb = rows.arm_a, rows.arm_b
     rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
+    if rows.moving:  # relative to a moving plane's surface
+        rel -= rows.surface
     vn = np.einsum("ij,ij->i", rel, c.normal)
     approaching = vn < -(allowance + APPROACH_SPEED)
     arriving = approaching & (-vn > threshold)

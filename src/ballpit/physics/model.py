@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import quaternion
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import INTEGRATORS, Integrator
 from .state import Columns
@@ -51,16 +50,14 @@ def sphere_columns() -> Columns:
 
 
 def plane_columns() -> Columns:
-    """Per-plane arrays: frame, half extents (inf for unbounded) and material."""
+    """Per-plane shape, motion and material: half extents (inf for unbounded), the velocity and angular
+    velocity it is moved with (world frame, about its centre), and its material. Its pose is state."""
     f = float
     return Columns(
         {
-            "center": ((3,), f),
-            "orientation": ((4,), f),
-            "normal": ((3,), f),  # the plane's +y axis
-            "axis_u": ((3,), f),  # width direction, the plane's +x axis
-            "axis_v": ((3,), f),  # depth direction, the plane's +z axis
             "half_size": ((2,), f),
+            "velocity": ((3,), f),
+            "angular_velocity": ((3,), f),
             "restitution": ((), f),
             "friction": ((), f),
             "rolling_friction": ((), f),
@@ -99,21 +96,10 @@ class Model:
         cols.full("rolling_friction")[rows] = rolling_friction
         return rows
 
-    def append_plane(self, center: np.ndarray, q: np.ndarray, half_size: tuple[float, float],
-                     materials: dict[str, float]) -> int:  # fmt: skip
-        """One more plane: centre, orientation (turning +y to its normal), half extents, materials."""
-        cols = self.planes
-        i = cols.reserve(1).start
-        axes = quaternion.rotate(q, np.eye(3))  # rows: the plane's x, y (normal) and z axes
-        cols.full("center")[i] = center
-        cols.full("orientation")[i] = q
-        cols.full("axis_u")[i] = axes[0]
-        cols.full("normal")[i] = axes[1] / np.linalg.norm(axes[1])
-        cols.full("axis_v")[i] = axes[2]
-        cols.full("half_size")[i] = half_size
-        for key, value in materials.items():
-            cols.full(key)[i] = value
-        return i
+    def moving_planes(self) -> bool:
+        """True when some plane has a velocity or an angular velocity."""
+        pl = self.planes
+        return bool(pl.velocity.any() or pl.angular_velocity.any())
 
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""

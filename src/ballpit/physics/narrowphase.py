@@ -21,7 +21,9 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
     """Gap, normal and point of every kept pair at the current positions."""
     x, radius = state.body[:, X], model.spheres.radius
     c = pairs
-    gp, np_, pp = collision.sphere_plane(x, radius, c.sphere, c.plane, c.side, model.planes)
+    pose = state.planes
+    gp, np_, pp = collision.sphere_plane(x, radius, c.sphere, c.plane, c.side, pose.center, pose.normal,
+                                         pose.axis_u, pose.axis_v, model.planes.half_size)  # fmt: skip
     gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
     static = np.full(len(c.sphere), model.spheres.count)
     return ContactPoints(

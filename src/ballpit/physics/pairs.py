@@ -4,7 +4,8 @@ box it was paired from.
 Boxes are swept over BROAD_PHASE_STEPS steps ahead, so most steps reuse their pairs: only the side
 each ball is on of each plane is refreshed (a ball moved by hand may have crossed one). The pairs
 expire when the number of balls or planes changes, or when some ball's path for the coming interval
-leaves its box or the sphere around its swept path.
+leaves its box or the sphere around its swept path. While a plane moves, the sphere–plane pairs are
+found again every step, from the kept boxes and the plane's sweep over the step.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import broadphase
+from . import broadphase, moving_planes
 from .integrators import Integrator
 from .model import Model
 from .state import State, V, X
@@ -77,6 +78,8 @@ class PairCache:
         counts = (model.spheres.count, model.planes.count)
         if c is None or c.counts != counts or c.escaped(model, state, accel, dt):
             return self.renew(model, state, dt, BROAD_PHASE_STEPS * dt, accel, accel)
+        if model.moving_planes():  # the planes moved since the pairs were found
+            c.sphere, c.plane = plane_pairs(model, state, c.lo, c.hi, dt)
         c.side = plane_sides(model, state, c.sphere, c.plane)
         return c
 
@@ -89,8 +92,8 @@ class PairCache:
 
 def plane_sides(model: Model, state: State, sphere: np.ndarray, plane: np.ndarray) -> np.ndarray:
     """±1: which side of each plane each ball's centre is on (+1 on the normal's side or in it)."""
-    pl = model.planes
-    signed = np.einsum("ij,ij->i", state.body[sphere, 0:3] - pl.center[plane], pl.normal[plane])
+    pose = state.planes
+    signed = np.einsum("ij,ij->i", state.body[sphere, 0:3] - pose.center[plane], pose.normal[plane])
     return np.where(signed < 0.0, -1.0, 1.0)
 
 
@@ -120,7 +123,18 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     lo -= pad
     hi += pad
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(lo, hi), centre, reach)
-    pl = model.planes
-    s, p = broadphase.sphere_plane_pairs(lo, hi, pl.center, pl.normal, pl.axis_u, pl.axis_v, pl.half_size)
+    s, p = plane_pairs(model, state, lo, hi, ahead)
     counts = (model.spheres.count, model.planes.count)
     return KeptPairs(lo, hi, centre, reach, i, j, s, p, plane_sides(model, state, s, p), counts)
+
+
+def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray,
+                h: float) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(sphere, plane) pairs whose boxes reach the plane, as it is or as it moves over ``h``."""
+    pose, pl = state.planes, model.planes
+    reach = None
+    if model.moving_planes():
+        reach = lambda p, distance: moving_planes.sweep(model, p, h, distance)  # noqa: E731
+    return broadphase.sphere_plane_pairs(
+        lo, hi, pose.center, pose.normal, pose.axis_u, pose.axis_v, pl.half_size, reach
+    )

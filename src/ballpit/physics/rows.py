@@ -13,7 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contacts import SPHERE_PLANE, ContactPoints
+from . import moving_planes
 from .model import Model
+from .state import State
 
 
 @dataclass
@@ -32,6 +34,9 @@ class ContactRows:
     restitution: np.ndarray
     friction: np.ndarray
     rolling: np.ndarray  # rolling resistance ρ·r (m): angular impulse per unit normal impulse
+    surface: np.ndarray  # (K, 3) velocity of b's surface at the contact beyond b's own (moving planes)
+    spin: np.ndarray  # (K, 3) angular velocity of that surface (a turning plane's ω)
+    moving: bool  # whether any contact has a moving surface (else surface and spin are zero)
     colours: list[np.ndarray]
 
     def __len__(self) -> int:
@@ -44,12 +49,12 @@ class ContactRows:
 
     def subset(self, mask: np.ndarray, static: int) -> ContactRows:
         """The contacts where ``mask`` holds, coloured afresh."""
-        fields = {k: v[mask] for k, v in vars(self).items() if k != "colours"}
-        return ContactRows(**fields, colours=colour(fields["a"], fields["b"], static))
+        fields = {k: v[mask] for k, v in vars(self).items() if k not in ("colours", "moving")}
+        return ContactRows(**fields, moving=self.moving, colours=colour(fields["a"], fields["b"], static))
 
 
-def contact_rows(model: Model, c: ContactPoints) -> ContactRows:
-    """Masses, lever arms and mixed materials of the contacts ``c``, grouped into colours."""
+def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
+    """Masses, lever arms, mixed materials and surface motion of the contacts ``c``, in colours."""
     sph, pl = model.spheres, model.planes
     with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
     radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
@@ -61,6 +66,11 @@ def contact_rows(model: Model, c: ContactPoints) -> ContactRows:
         other = np.where(on_plane, plane[p] if len(plane) else 0.0, ball[o])
         return rule(ball[c.a], other)
 
+    surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
+    moving = model.moving_planes()
+    if moving:  # a plane's surface moves at v + ω × (p − c) under the contact point
+        surface[on_plane] = moving_planes.surface_velocity(model, state, p[on_plane], c.point[on_plane])
+        spin[on_plane] = pl.angular_velocity[p[on_plane]]
     ra, rb = radius[c.a], radius[c.b]
     # Rolling resistance acts through the rolling radius: r for a ball on a plane, the reduced
     # radius 2·r_a·r_b/(r_a + r_b) between two balls.
@@ -78,6 +88,9 @@ def contact_rows(model: Model, c: ContactPoints) -> ContactRows:
         restitution=mixed(sph.restitution, pl.restitution, np.multiply),
         friction=np.sqrt(mixed(sph.friction, pl.friction, np.multiply)),
         rolling=np.sqrt(mixed(sph.rolling_friction, pl.rolling_friction, np.multiply)) * roll_radius,
+        surface=surface,
+        spin=spin,
+        moving=moving,
         colours=colour(c.a, c.b, sph.count),
     )
 

@@ -93,6 +93,8 @@ class _Colour:
         self.max_inv_m_t = float(inv_m_t.max())
         self.mu = contacts.friction[idx]
         self.rolling = contacts.rolling[idx]
+        self.moving = contacts.moving
+        self.surface, self.spin = contacts.surface[idx], contacts.spin[idx]
         self.has_friction = bool(self.mu.any())
         self.has_rolling = bool(self.rolling.any())
 
@@ -147,6 +149,8 @@ def solve(
             (va, wa), (vb, wb) = (g[0, :, :3], g[0, :, 3:]), (g[1, :, :3], g[1, :, 3:])
             # contact-point velocity of a relative to b: v_a − v_b − (ρ_a·ω_a + ρ_b·ω_b) × n
             rel = va - vb + np.einsum("kij,kj->ki", c.nx, c.ra * wa + c.rb * wb)
+            if c.moving:  # relative to a moving plane's surface
+                rel -= c.surface
             vn = np.einsum("ij,ij->i", rel, c.n)
 
             # normal: the accumulated impulse stays ≥ 0
@@ -172,7 +176,8 @@ def solve(
             if c.has_rolling:
                 # rolling resistance: oppose relative spin (after the friction turn), up to ρ·r·P_n
                 old_r = rolling[k]
-                new_r = _cap(old_r - c.m_r * (wa - wb), c.rolling * new)
+                spin = wa - wb - c.spin if c.moving else wa - wb
+                new_r = _cap(old_r - c.m_r * spin, c.rolling * new)
                 rolling[k] = new_r
                 g[:, :, 3:] += c.roll * (new_r - old_r)
 

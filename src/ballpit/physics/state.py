@@ -1,5 +1,5 @@
-"""The state: what a step advances (each ball's position, velocity, orientation and spin, and the
-time), kept apart from the model (``model.py``), what a step only reads.
+"""The state: what a step advances (each ball's position, velocity, orientation and spin, each
+plane's pose, and the time), kept apart from the model (``model.py``), what a step only reads.
 
 Storage is structure-of-arrays (``Columns``): arrays allocated with spare capacity that doubles when
 full, so adding balls one at a time is amortised O(1). The live part of each array is its first
@@ -56,11 +56,28 @@ class Columns:
         return arrays[name][: self.count]
 
 
+def plane_pose_columns() -> Columns:
+    """Per-plane pose: centre and frame. Planes are kinematic: a step moves them as told."""
+    f = float
+    return Columns(
+        {
+            "center": ((3,), f),
+            "orientation": ((4,), f),  # the rotation taking +y to the normal
+            "normal": ((3,), f),  # the plane's +y axis
+            "axis_u": ((3,), f),  # width direction, the plane's +x axis
+            "axis_v": ((3,), f),  # depth direction, the plane's +z axis
+        },
+        capacity=4,
+    )
+
+
 class State:
-    """What a step advances: the (N, 13) block ``[x v q ω]`` of every ball, and the world time (s)."""
+    """What a step advances: the (N, 13) block ``[x v q ω]`` of every ball, each plane's pose, and the
+    world time (s)."""
 
     def __init__(self) -> None:
         self._rows = Columns({"body": ((STATE_WIDTH,), float)})
+        self.planes = plane_pose_columns()
         self.time = 0.0
 
     @property

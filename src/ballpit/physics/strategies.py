@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import impacts, narrowphase, penetration, resting, rows, toi
-from .contacts import ContactPoints, EventLog
+from . import impacts, moving_planes, narrowphase, penetration, resting, rows, toi
+from .contacts import SPHERE_PLANE, ContactPoints, EventLog
 from .forces import ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
 from .model import Model
@@ -49,10 +49,12 @@ class Step:
     profile: StepProfile
 
     def integrate(self, push: ForceTerm | None, h: float) -> None:
-        """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``."""
+        """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``, and move
+        the planes along with them."""
         with self.profile.stage("integrate"):
             terms = self.forces if push is None else [*self.forces, push]
             integrate(self.model.integrator, self.state.body, terms, h, self.workspace)
+            moving_planes.advance(self.model, self.state, h)
         self.profile.intervals += 1
 
 
@@ -67,6 +69,9 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> Contact
     dt, model = step.dt, step.model
     v, acc = with_static(step.state.body[:, V]), with_static(accel)
     dv, da = v[c.a] - v[c.b], acc[c.a] - acc[c.b]
+    if model.moving_planes():  # relative to a moving plane's surface under the contact point
+        on = c.kind == SPHERE_PLANE
+        dv[on] -= moving_planes.surface_velocity(model, step.state, c.other[on], c.point[on])
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     if np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP)) <= model.crowd_limit:
         return None
@@ -92,7 +97,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
                 contacts = narrowphase.contact_points(model, state, pairs)
         touching = contacts.subset(contacts.gap < CONTACT_SLOP)
         with prof.stage("contact rows"):
-            batch = rows.contact_rows(model, touching)
+            batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):
             penetration.remove_penetration(state, touching, batch)
         no_allowance = np.zeros(len(touching))
@@ -137,7 +142,7 @@ def whole_with_speculative_contacts(step: Step, c: ContactPoints) -> None:
     model, state, prof, dt, now = step.model, step.state, step.profile, step.dt, step.state.time
     allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)  # how fast each may close (m/s)
     with prof.stage("contact rows"):
-        batch = rows.contact_rows(model, c)
+        batch = rows.contact_rows(model, state, c)
     with prof.stage("penetration"):
         penetration.remove_penetration(state, c, batch)
     with prof.stage("impacts"):

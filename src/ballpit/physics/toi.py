@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import collision
+from . import collision, moving_planes
 from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
 from .pairs import CONTACT_SLOP
@@ -63,7 +63,8 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     """Time until the first pair not yet touching comes into contact (inf if none within ``h``).
 
     Each ball follows the integrator's path under ``accel`` (its free acceleration plus the resting
-    forces). Impacts close in time are taken together: the result is the latest impact that leaves
+    forces), and each plane its own motion (moving_planes.py). Impacts close in time are taken
+    together: the result is the latest impact that leaves
     every earlier pair overlapping by less than IMPACT_OVERLAP of the smallest radius (removed next
     interval by moving positions). A lone impact is always met exactly.
     """
@@ -75,6 +76,11 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     acc = path.path_acceleration(with_static(accel))
     a, b = c.a[apart], c.b[apart]
     bound = path.closing_speed_bound(v[a] - v[b], acc[a] - acc[b], h)
+    if model.moving_planes():  # a plane's surface moves too: bound its approach as well
+        on = c.kind[apart] == SPHERE_PLANE
+        bound[on] = moving_planes.closing_speed_bound(
+            model, state, a[on], c.other[apart[on]], v[a[on]], acc[a[on]], h
+        )
     reachable = c.gap[apart] <= bound * h
     apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
     if apart.size == 0:
@@ -82,7 +88,8 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     on_plane = c.kind[apart] == SPHERE_PLANE
     radius = np.append(model.spheres.radius, 0.0)
     reach = radius[a] + radius[b]
-    pl = model.planes
+    pose, half = state.planes, model.planes.half_size
+    moving = model.moving_planes()
 
     def gap_at(k: np.ndarray, t: np.ndarray) -> np.ndarray:
         tt = t[:, None]
@@ -91,9 +98,14 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
         plane_k = on_plane[k]
         if plane_k.any():
             pk = c.other[apart[k[plane_k]]]
-            pb[plane_k] = collision.closest_point_on_planes(
-                pa[plane_k], pk, pl.center, pl.axis_u, pl.axis_v, pl.half_size
-            )
+            if moving:  # each plane where it will be after t
+                centre, u, w = moving_planes.frames_at(model, state, pk, t[plane_k])
+                rows = np.arange(len(pk))
+                pb[plane_k] = collision.closest_point_on_planes(pa[plane_k], rows, centre, u, w, half[pk])
+            else:
+                pb[plane_k] = collision.closest_point_on_planes(
+                    pa[plane_k], pk, pose.center, pose.axis_u, pose.axis_v, half
+                )
         return np.linalg.norm(pa - pb, axis=1) - reach[k]
 
     when = first_contact(gap_at, bound, h, 0.5 * CONTACT_SLOP)

@@ -14,7 +14,7 @@ from time import perf_counter
 
 import numpy as np
 
-from . import energy, narrowphase, quaternion, strategies, validation
+from . import energy, moving_planes, narrowphase, quaternion, strategies, validation
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .contacts import ContactRecord, EventLog
 from .forces import ForceTerm, free_acceleration
@@ -258,11 +258,16 @@ class World:
         restitution: float = PLANE_RESTITUTION,
         friction: float = FRICTION,
         rolling_friction: float = ROLLING_FRICTION,
+        velocity: object = (0.0, 0.0, 0.0),
+        angular_velocity: object = (0.0, 0.0, 0.0),
     ) -> Plane:
-        """Add a static plane: infinite (``size=None``), square (a side) or rectangular ((width, depth)).
+        """Add a plane: infinite (``size=None``), square (a side) or rectangular ((width, depth)).
 
         Orient it with ``rotation`` (extrinsic x, y, z Euler angles in degrees, turning the +y plane) or
         with ``normal`` (the shortest turn from +y), not both; with neither its normal is +y.
+
+        A plane is kinematic: ``velocity`` (m/s) and ``angular_velocity`` (rad/s, world frame, about
+        its centre) move it during each step, and no ball pushes it.
         """
         center = validation.vector("position", position)
         if normal is not None and rotation is not None:
@@ -281,7 +286,17 @@ class World:
             "friction": validation.number("friction", friction, nonnegative=True),
             "rolling_friction": validation.number("rolling_friction", rolling_friction, nonnegative=True),
         }
-        i = self.model.append_plane(center, q, (0.5 * width, 0.5 * depth), mat)
+        shape = self.model.planes
+        i = shape.reserve(1).start
+        shape.full("half_size")[i] = (0.5 * width, 0.5 * depth)
+        shape.full("velocity")[i] = validation.vector("velocity", velocity)
+        shape.full("angular_velocity")[i] = validation.vector("angular_velocity", angular_velocity)
+        for key, value in mat.items():
+            shape.full(key)[i] = value
+        pose = self.state.planes
+        pose.reserve(1)
+        pose.full("center")[i] = center
+        moving_planes.set_orientation(pose, i, q)
         return Plane(self, i)
 
     # ------------------------------------------------------------------ stepping
