@@ -20,6 +20,13 @@ if TYPE_CHECKING:
     from .world import World
 
 
+_LIMITS = {
+    "position": validation.MAX_COORDINATE,
+    "velocity": validation.MAX_SPEED,
+    "angular_velocity": validation.MAX_SPIN,
+}
+
+
 def _state_vector(cols: slice, name: str, length: int):
     def get(self: Sphere) -> np.ndarray:
         return self._world.state.body[self.index, cols]
@@ -28,7 +35,7 @@ def _state_vector(cols: slice, name: str, length: int):
         if name == "orientation":
             vec = validation.quaternion(name, value)
         else:
-            vec = validation.vector(name, value, length)
+            vec = validation.vector(name, value, length, limit=_LIMITS[name])
         self._world.state.body[self.index, cols] = vec
 
     return property(get, set, doc=f"The ball's {name.replace('_', ' ')} (world frame).")
@@ -60,7 +67,8 @@ def _plane_motion(name: str, doc: str) -> property:
         return getattr(self._columns, name)[self.index]
 
     def set(self: Plane, value: object) -> None:
-        getattr(self._columns, name)[self.index] = validation.vector(name, value)
+        limit = validation.MAX_SPEED if name == "velocity" else validation.MAX_SPIN
+        getattr(self._columns, name)[self.index] = validation.vector(name, value, limit=limit)
 
     return property(get, set, doc=doc)
 

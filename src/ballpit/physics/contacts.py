@@ -95,6 +95,12 @@ class ContactPoints:
     def subset(self, mask: np.ndarray) -> ContactPoints:
         return ContactPoints(**{f.name: getattr(self, f.name)[mask] for f in fields(ContactPoints)})
 
+    @staticmethod
+    def concatenate(parts: list[ContactPoints]) -> ContactPoints:
+        return ContactPoints(
+            **{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(ContactPoints)}
+        )
+
     def keys(self) -> np.ndarray:
         """A unique integer per pair, built from the pair's own identity (the ball's index and the
         other ball's or the plane's), so a key never changes meaning when bodies are added."""
@@ -144,12 +150,7 @@ class EventLog:
         time = np.concatenate([p[0] for p in self._parts])
         keys = np.concatenate([p[2] for p in self._parts])
         impulse = np.concatenate([p[3] for p in self._parts])
-        c = ContactPoints(
-            **{
-                f.name: np.concatenate([getattr(p[1], f.name) for p in self._parts])
-                for f in fields(ContactPoints)
-            }
-        )
+        c = ContactPoints.concatenate([p[1] for p in self._parts])
         # One entry per pair: the first time it was resolved (its point and normal then), the total impulse.
         unique, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
         total = np.zeros(len(unique))

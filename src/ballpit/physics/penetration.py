@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .contacts import ContactPoints
+from .model import Model
 from .rows import ContactRows
 from .state import State, X, with_static
 
@@ -19,8 +20,8 @@ OVERLAP_TOLERANCE = 1e-7
 SWEEPS = 4
 
 
-def remove_penetration(state: State, c: ContactPoints, rows: ContactRows) -> None:
-    """Move overlapping balls apart along the contact normals (positions only)."""
+def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
+    """Move overlapping balls apart along the contact normals (positions only), never through a plane."""
     if not np.any(c.gap < -OVERLAP_TOLERANCE):
         return
     x = state.body[:, X]
@@ -36,4 +37,37 @@ def remove_penetration(state: State, c: ContactPoints, rows: ContactRows) -> Non
             pos[a] += depth * share[idx, None]
             pos[b] -= depth * (1.0 - share[idx, None])
         pos[-1] = 0.0
-    x[:] = pos[:-1]
+    x[:] = keep_sides_of_planes(model, state, x, pos[:-1])
+
+
+def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """``new`` positions, except that no ball's centre crosses a plane on its way from ``old``: one
+    that would is stopped where it touches the plane (or where it was, if it already overlapped it).
+
+    Pushing apart many balls at one point can move a ball far along a normal that no plane contact
+    limits (the plane was not within its reach), and planes are two-sided: through one, it would be
+    pushed on out the wrong side.
+    """
+    moved = np.flatnonzero((new != old).any(axis=1))
+    if moved.size == 0 or model.planes.count == 0:
+        return new
+    pose, half, radius = state.planes, model.planes.half_size, model.spheres.radius[moved]
+    start, path = old[moved], new[moved] - old[moved]
+    t = np.ones(len(moved))
+    for p in range(model.planes.count):
+        d0 = (start - pose.center[p]) @ pose.normal[p]
+        d1 = d0 + path @ pose.normal[p]
+        crossing = (d0 >= 0.0) != (d1 >= 0.0)
+        if not crossing.any():
+            continue
+        k = np.flatnonzero(crossing)
+        through = start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k]  # where the centre crosses
+        rel = through - pose.center[p]
+        inside = (np.abs(rel @ pose.axis_u[p]) <= half[p, 0]) & (np.abs(rel @ pose.axis_v[p]) <= half[p, 1])
+        k = k[inside]
+        # stop at the signed distance ±min(r, |d0|): touching it, on the side the ball came from
+        stop = np.sign(d0[k]) * np.minimum(radius[k], np.abs(d0[k]))
+        t[k] = np.minimum(t[k], (d0[k] - stop) / (d0[k] - d1[k]))
+    out = new.copy()
+    out[moved] = start + t[:, None] * path
+    return out

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contacts import SPHERE_PLANE, ContactPoints
 from . import moving_planes
+from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
 from .state import State
 

@@ -20,17 +20,21 @@ import numpy as np
 
 from . import impacts, moving_planes, narrowphase, penetration, resting, rows, toi
 from .contacts import SPHERE_PLANE, ContactPoints, EventLog
-from .forces import ForceTerm, free_acceleration
+from .forces import ConstantPerBall, ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
 from .model import Model
 from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache
 from .profile import StepProfile
-from .state import State, V, with_static
+from .state import State, V, W, with_static
 
 # The pairs of a crowded step are those within this many times the distance they could close.
 SPECULATIVE_REACH = 2.0
-# A step is split at most this many times; past it the rest of the step is taken whole.
-MAX_INTERVALS = 10_000
+# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
+# fraction of the smaller radius cuts the step short at its impact.
+UNGUARDED_OVERLAP = 0.05
+# A step is split at most this many times; past it the rest of the step is finished conservatively:
+# the balls that could meet anything stop where they are (see ``finish_conservatively``).
+MAX_INTERVALS = 1_000
 
 
 @dataclass
@@ -67,28 +71,46 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> Contact
     impact uses), touching ones included.
     """
     dt, model = step.dt, step.model
+    dv, da = _relative_motion(step, c, accel)
+    ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
+    if np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP)) <= model.crowd_limit:
+        return None
+    return c.subset(speculative_reach(step, c, accel, dv, da))
+
+
+def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray, dv: np.ndarray | None = None,
+                      da: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """The contacts of ``c`` within SPECULATIVE_REACH times the distance they could close in the step
+    (by the same bound the time of impact uses), touching ones included; ``dv`` and ``da`` are the
+    pairs' relative velocities and accelerations, worked out here when not given."""
+    if dv is None or da is None:
+        dv, da = _relative_motion(step, c, accel)
+    closing = step.model.integrator.closing_speed_bound(dv, da, step.dt) * step.dt
+    return c.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing
+
+
+def _relative_motion(step: Step, c: ContactPoints, accel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's relative velocity (against a moving plane's surface) and acceleration."""
+    model = step.model
     v, acc = with_static(step.state.body[:, V]), with_static(accel)
     dv, da = v[c.a] - v[c.b], acc[c.a] - acc[c.b]
     if model.moving_planes():  # relative to a moving plane's surface under the contact point
         on = c.kind == SPHERE_PLANE
         dv[on] -= moving_planes.surface_velocity(model, step.state, c.other[on], c.point[on])
-    ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
-    if np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP)) <= model.crowd_limit:
-        return None
-    closing = model.integrator.closing_speed_bound(dv, da, dt) * dt
-    return c.subset(c.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing)
+    return dv, da
 
 
 def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
-                     accel: tuple[np.ndarray, np.ndarray]) -> None:  # fmt: skip
-    """The step split at every impact, so balls meet exactly when they touch.
+                     accel: tuple[np.ndarray, np.ndarray], elapsed: float = 0.0) -> None:  # fmt: skip
+    """The step (from ``elapsed`` into it) split at every impact, so balls meet exactly when they
+    touch.
 
-    ``contacts`` are the kept ``pairs`` measured at the step's start, and ``accel`` the free linear
-    and angular accelerations there.
+    ``contacts`` are the kept ``pairs`` measured now, and ``accel`` the free linear and angular
+    accelerations now.
     """
     model, state, prof, dt = step.model, step.state, step.profile, step.dt
     free, ang = accel
-    start, elapsed = state.time, 0.0
+    start = state.time
     while elapsed < dt:
         remaining, now = dt - elapsed, start + elapsed
         first = prof.intervals == 0
@@ -99,7 +121,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         with prof.stage("contact rows"):
             batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):
-            penetration.remove_penetration(state, touching, batch)
+            penetration.remove_penetration(model, state, touching, batch)
         no_allowance = np.zeros(len(touching))
         with prof.stage("impacts"):
             impacts.bounce(model, state, touching, batch, step.threshold, no_allowance, step.events, now,
@@ -118,39 +140,95 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
                 pairs = step.pairs.renew(model, state, remaining, ahead, lin, free)
                 contacts = narrowphase.contact_points(model, state, pairs)
-        if prof.intervals + 1 < MAX_INTERVALS:
-            with prof.stage("time of impact"):
-                h = min(toi.next_impact(model, state, contacts, lin, remaining), remaining)
-        else:  # a pathological pile-up: finish the step without splitting it further
-            h = remaining
+        if prof.intervals + 1 >= MAX_INTERVALS:  # a pathological pile-up: no more splitting
+            finish_conservatively(step, contacts, push, lin, remaining)
+            step.events.close_interval(1.0)
+            return
+        with prof.stage("time of impact"):
+            h = min(toi.next_impact(model, state, contacts, lin, remaining), remaining)
         step.integrate(push, h)
         step.events.close_interval(h / remaining)
         elapsed = dt if h >= remaining else elapsed + h
 
 
-def whole_with_speculative_contacts(step: Step, c: ContactPoints) -> None:
-    """The whole step as one interval, with speculative contacts ``c`` (from ``crowded_contacts``).
+def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPerBall | None,
+                          lin: np.ndarray, remaining: float) -> None:  # fmt: skip
+    """Take the rest of a step that ran out of intervals in one go, passing through nothing: every
+    ball that could reach anything in that time stops where it is (velocity and spin zero, its
+    forces balanced), and the others, which cannot, move on."""
+    model, state = step.model, step.state
+    with step.profile.stage("time of impact"):
+        stop = toi.threatened(model, state, contacts, lin, remaining)
+    body = state.body
+    body[stop, V] = 0.0
+    body[stop, W] = 0.0
+    free, ang = free_acceleration(body, step.forces)
+    held_lin = free if push is None else free + push.lin
+    held_ang = ang if push is None else ang + push.ang
+    hold = ConstantPerBall(np.where(stop[:, None], -held_lin, 0.0), np.where(stop[:, None], -held_ang, 0.0))
+    if push is not None:
+        hold = ConstantPerBall(hold.lin + push.lin, hold.ang + push.ang)
+    step.integrate(hold, remaining)
+
+
+def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
+                                    c: ContactPoints) -> None:  # fmt: skip
+    """The whole step as one interval, with speculative contacts ``c`` (from ``crowded_contacts``);
+    ``contacts`` are all the kept ``pairs`` measured now.
 
     A contact with a gap may close by at most that gap, v_n ≥ −gap/dt, and the constraint only pushes
     if the pair would otherwise pass it. A pair arriving faster than the bounce threshold leaves at e
     times its approach speed, as in a split step, but from where it was when the step began: a bounce
     is early by at most the gap it had left (≤ v·dt). Slower approaches start no bounce island; the
-    resting forces stop them within the step. Pairs missed because a bounce turned a ball towards a
-    ball it was not near overlap slightly; the next step's penetration removal and bounce deal with
-    them, and its broad phase checks every path again.
+    resting forces stop them within the step.
+
+    A bounce can turn a ball towards a body it was not near, whose pair is not among ``c``. Before
+    moving, every such pair is followed along the new paths; if one would overlap by more than
+    UNGUARDED_OVERLAP of a radius within the step, the step goes only as far as its impact and the rest
+    of it is split at impacts. So nothing passes through a plane or a ball, however hard it was hit;
+    shallower overlaps are removed at the next step's start.
     """
     model, state, prof, dt, now = step.model, step.state, step.profile, step.dt, step.state.time
     allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)  # how fast each may close (m/s)
     with prof.stage("contact rows"):
         batch = rows.contact_rows(model, state, c)
     with prof.stage("penetration"):
-        penetration.remove_penetration(state, c, batch)
+        penetration.remove_penetration(model, state, c, batch)
     with prof.stage("impacts"):
         impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
                        arrivals_only=True)  # fmt: skip
     free, ang = free_acceleration(state.body, step.forces)
+    # The bounces turned some balls towards neighbours they were not closing on before: those pairs
+    # join the speculative contacts, and bounce in turn if they now arrive.
+    with prof.stage("crowd test"):
+        reach = speculative_reach(step, contacts, free)
+        joined = reach & ~np.isin(contacts.keys(), c.keys())
+    if joined.any():
+        c = ContactPoints.concatenate([c, contacts.subset(joined)])
+        allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
+        with prof.stage("contact rows"):
+            batch = rows.contact_rows(model, state, c)
+        with prof.stage("impacts"):
+            impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
+                           arrivals_only=True)  # fmt: skip
+        free, ang = free_acceleration(state.body, step.forces)
     with prof.stage("resting solve"):
         push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, -allowance, step.warm,
                                       step.events, now)  # fmt: skip
-    step.integrate(push, dt)
-    step.events.close_interval(1.0)
+    lin = free if push is None else free + push.lin
+    with prof.stage("pairs"):
+        if pairs.escaped(model, state, lin, dt):
+            pairs = step.pairs.renew(model, state, dt, BROAD_PHASE_STEPS * dt, lin, free)
+        contacts = narrowphase.contact_points(model, state, pairs)
+        unguarded = contacts.subset(~np.isin(contacts.keys(), c.keys()))
+    with prof.stage("time of impact"):
+        deep = toi.deep_overlaps(model, state, unguarded, lin, dt, UNGUARDED_OVERLAP)
+        h = toi.next_impact(model, state, unguarded.subset(deep), lin, dt) if deep.any() else np.inf
+    if h >= dt:
+        step.integrate(push, dt)
+        step.events.close_interval(1.0)
+        return
+    step.integrate(push, h)
+    step.events.close_interval(h / dt)
+    # the rest of the step, split at impacts (its first interval measures the contacts afresh)
+    split_at_impacts(step, contacts, pairs, (free, ang), elapsed=h)

@@ -29,10 +29,11 @@ def first_contact(
     gap_at: Callable[[np.ndarray, np.ndarray], np.ndarray],
     speed_bound: np.ndarray,
     t_max: float,
-    tolerance: float,
+    tolerance: float | np.ndarray,
     max_iterations: int = 48,
 ) -> np.ndarray:
-    """Earliest time in [0, t_max] at which each pair's gap falls to ``tolerance`` (inf if none).
+    """Earliest time in [0, t_max] at which each pair's gap falls to ``tolerance`` (one for all, or
+    one per pair; inf if none).
 
     ``gap_at(k, t)`` gives the gaps of pairs ``k`` at times ``t``. A pair still converging after
     ``max_iterations`` reports the time it reached, a safe lower bound: the caller advances to it and
@@ -43,8 +44,9 @@ def first_contact(
     when = np.full(count, np.inf)
     active = np.arange(count)
     gap = gap_at(active, t)
+    per_pair = np.ndim(tolerance) > 0
     for _ in range(max_iterations):
-        touching = gap <= tolerance
+        touching = gap <= (tolerance[active] if per_pair else tolerance)
         when[active[touching]] = t[active[touching]]
         moving = ~touching & (speed_bound[active] > 0.0)
         active, gap = active[moving], gap[moving]
@@ -64,13 +66,41 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
 
     Each ball follows the integrator's path under ``accel`` (its free acceleration plus the resting
     forces), and each plane its own motion (moving_planes.py). Impacts close in time are taken
-    together: the result is the latest impact that leaves
-    every earlier pair overlapping by less than IMPACT_OVERLAP of the smallest radius (removed next
-    interval by moving positions). A lone impact is always met exactly.
+    together: the result is the latest impact that leaves every earlier pair overlapping by less than
+    IMPACT_OVERLAP of the smallest radius (removed next interval by moving positions). A lone impact is
+    always met exactly.
     """
-    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
-    if apart.size == 0:
+    when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * CONTACT_SLOP)
+    hit = np.isfinite(when)
+    if not hit.any():
         return np.inf
+    order = np.argsort(when[hit], kind="stable")
+    t, speed = when[hit][order], bound[hit][order]
+    overlap = (t - t[0]) * np.maximum.accumulate(speed)
+    allowed = IMPACT_OVERLAP * float(model.spheres.radius.min())
+    return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
+
+
+def deep_overlaps(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float,
+                  depth: float) -> np.ndarray:  # fmt: skip
+    """The pairs of ``c`` (not yet touching) that would overlap by more than ``depth`` times the
+    smaller radius within ``h``, as a mask over ``c``."""
+    deep = lambda ra, rb: -depth * np.where(rb > 0.0, np.minimum(ra, rb), ra)  # noqa: E731
+    when, _, pairs = meetings(model, state, c, accel, h, deep)
+    mask = np.zeros(len(c), bool)
+    mask[pairs[np.isfinite(when)]] = True
+    return mask
+
+
+def meetings(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float,
+             target) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
+    ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
+    all (their indices into ``c``)."""
+    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+    none = np.zeros(0)
+    if apart.size == 0:
+        return none, none, apart
     body, path = state.body, model.integrator
     x, v = with_static(body[:, X]), with_static(body[:, V])
     acc = path.path_acceleration(with_static(accel))
@@ -81,12 +111,15 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
         bound[on] = moving_planes.closing_speed_bound(
             model, state, a[on], c.other[apart[on]], v[a[on]], acc[a[on]], h
         )
-    reachable = c.gap[apart] <= bound * h
-    apart, a, b, bound = apart[reachable], a[reachable], b[reachable], bound[reachable]
-    if apart.size == 0:
-        return np.inf
-    on_plane = c.kind[apart] == SPHERE_PLANE
     radius = np.append(model.spheres.radius, 0.0)
+    goal = np.broadcast_to(target(radius[a], radius[b]), a.shape)
+    # (a gap that need only fall to a small positive target counts as reachable when it could close
+    # altogether, as it always has)
+    reachable = c.gap[apart] - np.minimum(goal, 0.0) <= bound * h
+    apart, a, b, bound, goal = apart[reachable], a[reachable], b[reachable], bound[reachable], goal[reachable]
+    if apart.size == 0:
+        return none, none, apart
+    on_plane = c.kind[apart] == SPHERE_PLANE
     reach = radius[a] + radius[b]
     pose, half = state.planes, model.planes.half_size
     moving = model.moving_planes()
@@ -108,12 +141,29 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
                 )
         return np.linalg.norm(pa - pb, axis=1) - reach[k]
 
-    when = first_contact(gap_at, bound, h, 0.5 * CONTACT_SLOP)
-    hit = np.isfinite(when)
-    if not hit.any():
-        return np.inf
-    order = np.argsort(when[hit], kind="stable")
-    t, speed = when[hit][order], bound[hit][order]
-    overlap = (t - t[0]) * np.maximum.accumulate(speed)
-    allowed = IMPACT_OVERLAP * float(model.spheres.radius.min())
-    return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
+    return first_contact(gap_at, bound, h, goal), bound, apart
+
+
+def threatened(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float) -> np.ndarray:
+    """Balls that could reach a pair not yet touching within ``h``, whether the other body keeps
+    moving or stops: the bound |v_a| + |v_b| + (|a_a| + |a_b|)·h covers both (a plane's motion is
+    bounded as in ``next_impact``). A (N,) mask."""
+    n = model.spheres.count
+    hit = np.zeros(n + 1, bool)
+    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+    if apart.size:
+        body, path = state.body, model.integrator
+        speed = np.append(np.linalg.norm(body[:, V], axis=1), 0.0)
+        acc = np.append(np.linalg.norm(path.path_acceleration(accel), axis=1), 0.0)
+        a, b = c.a[apart], c.b[apart]
+        bound = speed[a] + speed[b] + (acc[a] + acc[b]) * h
+        if model.moving_planes():
+            on = c.kind[apart] == SPHERE_PLANE
+            v, aa = with_static(body[:, V]), with_static(path.path_acceleration(accel))
+            bound[on] = moving_planes.closing_speed_bound(
+                model, state, a[on], c.other[apart[on]], v[a[on]], aa[a[on]], h
+            )
+        reach = c.gap[apart] <= bound * h
+        hit[a[reach]] = True
+        hit[b[reach]] = True
+    return hit[:n]

@@ -7,9 +7,18 @@ from collections.abc import Sequence
 
 import numpy as np
 
+# What the engine can step: far enough inside float64 that squares, products and sums of these never
+# overflow or underflow (a speed of 1e154 m/s once overflowed v² in the time of impact and hung a step).
+MAX_COORDINATE = 1e9  # m, any coordinate of a ball or plane centre
+MAX_SPEED = 1e9  # m/s
+MAX_SPIN = 1e9  # rad/s
+RADIUS_RANGE = (1e-9, 1e9)  # m
+MASS_RANGE = (1e-12, 1e12)  # kg
 
-def vector(name: str, value: object, length: int = 3) -> np.ndarray:
-    """A finite float vector of the given length, or TypeError/ValueError naming ``name``."""
+
+def vector(name: str, value: object, length: int = 3, limit: float = math.inf) -> np.ndarray:
+    """A finite float vector of the given length, each component at most ``limit`` in size, or
+    TypeError/ValueError naming ``name``."""
     if isinstance(value, str | bytes) or value is None:
         raise TypeError(f"{name} must be a sequence of {length} numbers, got {value!r}")
     try:
@@ -20,13 +29,21 @@ def vector(name: str, value: object, length: int = 3) -> np.ndarray:
         raise ValueError(f"{name} must have {length} components, got {value!r}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be finite, got {value!r}")
+    if np.any(np.abs(arr) > limit):
+        raise ValueError(f"{name} must have components of at most {limit:g} in size, got {value!r}")
     return arr
 
 
 def number(
-    name: str, value: object, *, positive: bool = False, nonnegative: bool = False, infinite: bool = False
+    name: str,
+    value: object,
+    *,
+    positive: bool = False,
+    nonnegative: bool = False,
+    infinite: bool = False,
+    within: tuple[float, float] | None = None,
 ) -> float:
-    """A finite float (or ±inf if ``infinite``; never NaN), optionally > 0 or ≥ 0."""
+    """A finite float (or ±inf if ``infinite``; never NaN), optionally > 0, ≥ 0 or ``within`` a range."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise TypeError(f"{name} must be a number, got {value!r}")
     x = float(value)
@@ -36,12 +53,17 @@ def number(
         raise ValueError(f"{name} must be positive, got {value!r}")
     if nonnegative and x < 0.0:
         raise ValueError(f"{name} must not be negative, got {value!r}")
+    if within is not None and not within[0] <= x <= within[1]:
+        raise ValueError(f"{name} must be from {within[0]:g} to {within[1]:g}, got {value!r}")
     return x
 
 
 def unit_vector(name: str, value: object) -> np.ndarray:
-    """A finite non-zero 3-vector, normalised."""
+    """A finite non-zero 3-vector, normalised (scaled first, so huge components keep their direction)."""
     v = vector(name, value)
+    biggest = float(np.abs(v).max())
+    if biggest > 1.0:
+        v = v / biggest
     norm = float(np.linalg.norm(v))
     if norm < 1e-12:
         raise ValueError(f"{name} must not be a zero vector, got {value!r}")
@@ -49,8 +71,11 @@ def unit_vector(name: str, value: object) -> np.ndarray:
 
 
 def quaternion(name: str, value: object) -> np.ndarray:
-    """A finite non-zero (x, y, z, w) quaternion, normalised."""
+    """A finite non-zero (x, y, z, w) quaternion, normalised (scaled first, like ``unit_vector``)."""
     q = vector(name, value, 4)
+    biggest = float(np.abs(q).max())
+    if biggest > 1.0:
+        q = q / biggest
     norm = float(np.linalg.norm(q))
     if norm < 1e-12:
         raise ValueError(f"{name} must not be a zero quaternion, got {value!r}")
@@ -77,8 +102,9 @@ def _extent(name: str, v: object, whole: object) -> float:
     return x
 
 
-def array_of(name: str, value: object, count: int, width: int | None) -> np.ndarray:
-    """Broadcast a batch argument to (count,) or (count, width) floats, all finite."""
+def array_of(name: str, value: object, count: int, width: int | None,
+             within: tuple[float, float] = (-math.inf, math.inf)) -> np.ndarray:  # fmt: skip
+    """Broadcast a batch argument to (count,) or (count, width) floats, all finite and ``within``."""
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -91,20 +117,33 @@ def array_of(name: str, value: object, count: int, width: int | None) -> np.ndar
     if not np.all(np.isfinite(arr)):
         bad = arr[~np.isfinite(arr)].ravel()[0]
         raise ValueError(f"{name} must be finite, got {bad!r}")
+    outside = (arr < within[0]) | (arr > within[1])
+    if outside.any():
+        bad = arr[outside].ravel()[0]
+        raise ValueError(f"{name} must be from {within[0]:g} to {within[1]:g}, got {bad!r}")
     return arr
 
 
-# Column ranges of a ball's state row [x v q ω], for naming what went non-finite.
-_STATE_FIELDS = (("position", 0, 3), ("velocity", 3, 6), ("orientation", 6, 10), ("angular_velocity", 10, 13))
+# Column ranges of a ball's state row [x v q ω] and what each may hold, for naming what went wrong.
+_STATE_FIELDS = (
+    ("position", 0, 3, MAX_COORDINATE),
+    ("velocity", 3, 6, MAX_SPEED),
+    ("orientation", 6, 10, math.inf),
+    ("angular_velocity", 10, 13, MAX_SPIN),
+)
+_STATE_LIMITS = np.concatenate([np.full(stop - start, lim) for _, start, stop, lim in _STATE_FIELDS])
 
 
-def reject_non_finite_state(body: np.ndarray) -> None:
-    """Refuse to step from a NaN/inf written straight into the arrays (the setters check theirs)."""
-    if np.isfinite(body).all():
+def reject_unsteppable_state(body: np.ndarray) -> None:
+    """Refuse to step from a NaN/inf, or a value beyond what the engine can step, written straight
+    into the arrays (the setters check theirs)."""
+    bad = ~(np.abs(body) <= _STATE_LIMITS)  # NaN compares false
+    if not bad.any():
         return
-    row, col = np.argwhere(~np.isfinite(body))[0]
-    field = next(name for name, start, stop in _STATE_FIELDS if start <= col < stop)
-    raise ValueError(f"sphere #{row} has a non-finite {field} ({body[row, col]}); the world was not stepped")
+    row, col = np.argwhere(bad)[0]
+    field, _, _, limit = next(f for f in _STATE_FIELDS if f[1] <= col < f[2])
+    what = "a non-finite" if not np.isfinite(body[row, col]) else f"beyond {limit:g} in its"
+    raise ValueError(f"sphere #{row} has {what} {field} ({body[row, col]}); the world was not stepped")
 
 
 def undo_non_finite_step(body: np.ndarray, before: np.ndarray) -> None:

@@ -48,6 +48,10 @@ class Snapshot:
     crowded_steps: int
 
 
+def _symmetric(limit: float) -> tuple[float, float]:
+    return (-limit, limit)
+
+
 def _model_number(name: str, doc: str, **checks: bool) -> property:
     """A World parameter stored in the model, validated on the way in."""
 
@@ -175,12 +179,14 @@ class World:
     ) -> Sphere:
         """Add one ball and return its live view."""
         row = dict(
-            position=validation.vector("position", position),
-            velocity=validation.vector("velocity", velocity),
-            angular_velocity=validation.vector("angular_velocity", angular_velocity),
+            position=validation.vector("position", position, limit=validation.MAX_COORDINATE),
+            velocity=validation.vector("velocity", velocity, limit=validation.MAX_SPEED),
+            angular_velocity=validation.vector(
+                "angular_velocity", angular_velocity, limit=validation.MAX_SPIN
+            ),
             orientation=validation.quaternion("orientation", orientation),
-            radius=validation.number("radius", radius, positive=True),
-            mass=validation.number("mass", mass, positive=True),
+            radius=validation.number("radius", radius, within=validation.RADIUS_RANGE),
+            mass=validation.number("mass", mass, within=validation.MASS_RANGE),
             restitution=validation.number("restitution", restitution, nonnegative=True),
             friction=validation.number("friction", friction, nonnegative=True),
             rolling_friction=validation.number("rolling_friction", rolling_friction, nonnegative=True),
@@ -212,26 +218,27 @@ class World:
             raise ValueError(f"positions must have shape (N, 3), got shape {pos.shape}")
         n = len(pos)
         rows = dict(
-            position=validation.array_of("positions", pos, n, 3),
-            velocity=validation.array_of("velocity", velocity, n, 3),
-            angular_velocity=validation.array_of("angular_velocity", angular_velocity, n, 3),
+            position=validation.array_of("positions", pos, n, 3, _symmetric(validation.MAX_COORDINATE)),
+            velocity=validation.array_of("velocity", velocity, n, 3, _symmetric(validation.MAX_SPEED)),
+            angular_velocity=validation.array_of(
+                "angular_velocity", angular_velocity, n, 3, _symmetric(validation.MAX_SPIN)
+            ),
             orientation=validation.array_of("orientation", orientation, n, 4),
-            radius=validation.array_of("radius", radius, n, None),
-            mass=validation.array_of("mass", mass, n, None),
+            radius=validation.array_of("radius", radius, n, None, validation.RADIUS_RANGE),
+            mass=validation.array_of("mass", mass, n, None, validation.MASS_RANGE),
             restitution=validation.array_of("restitution", restitution, n, None),
             friction=validation.array_of("friction", friction, n, None),
             rolling_friction=validation.array_of("rolling_friction", rolling_friction, n, None),
         )
-        for key in ("radius", "mass"):
-            if np.any(rows[key] <= 0):
-                raise ValueError(f"{key} must be positive, got {rows[key][rows[key] <= 0][0]!r}")
         for key in ("restitution", "friction", "rolling_friction"):
             if np.any(rows[key] < 0):
                 raise ValueError(f"{key} must not be negative, got {rows[key][rows[key] < 0][0]!r}")
-        qnorm = np.linalg.norm(rows["orientation"], axis=1)
+        q = rows["orientation"]
+        q = q / np.maximum(np.abs(q).max(axis=1, keepdims=True), 1.0)  # huge components keep their turn
+        qnorm = np.linalg.norm(q, axis=1)
         if np.any(qnorm < 1e-12):
             raise ValueError("orientation must not be a zero quaternion")
-        rows["orientation"] = rows["orientation"] / qnorm[:, None]
+        rows["orientation"] = q / qnorm[:, None]
         hollow_in = np.asarray(hollow)
         if hollow_in.dtype != np.bool_:
             raise TypeError(f"hollow must be True or False (or an array of them), got {hollow!r}")
@@ -269,7 +276,7 @@ class World:
         A plane is kinematic: ``velocity`` (m/s) and ``angular_velocity`` (rad/s, world frame, about
         its centre) move it during each step, and no ball pushes it.
         """
-        center = validation.vector("position", position)
+        center = validation.vector("position", position, limit=validation.MAX_COORDINATE)
         if normal is not None and rotation is not None:
             raise ValueError(
                 f"give a plane's normal or its rotation, not both (normal={normal!r}, rotation={rotation!r})"
@@ -289,8 +296,10 @@ class World:
         shape = self.model.planes
         i = shape.reserve(1).start
         shape.full("half_size")[i] = (0.5 * width, 0.5 * depth)
-        shape.full("velocity")[i] = validation.vector("velocity", velocity)
-        shape.full("angular_velocity")[i] = validation.vector("angular_velocity", angular_velocity)
+        shape.full("velocity")[i] = validation.vector("velocity", velocity, limit=validation.MAX_SPEED)
+        shape.full("angular_velocity")[i] = validation.vector(
+            "angular_velocity", angular_velocity, limit=validation.MAX_SPIN
+        )
         for key, value in mat.items():
             shape.full(key)[i] = value
         pose = self.state.planes
@@ -315,7 +324,7 @@ class World:
         dt = validation.number("dt", dt, positive=True)
         began = perf_counter()
         model, state = self.model, self.state
-        validation.reject_non_finite_state(state.body)
+        validation.reject_unsteppable_state(state.body)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
                                model.bounce_threshold(dt), EventLog(), StepProfile())  # fmt: skip
@@ -330,7 +339,7 @@ class World:
         if crowd is None:
             strategies.split_at_impacts(step, contacts, pairs, (free, ang))
         else:
-            strategies.whole_with_speculative_contacts(step, crowd)
+            strategies.whole_with_speculative_contacts(step, contacts, pairs, crowd)
             self.crowded_steps += 1
         validation.undo_non_finite_step(state.body, before)
         state.time += dt

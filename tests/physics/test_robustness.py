@@ -1,0 +1,147 @@
+"""Nothing leaves a closed box or passes through a plane, whatever the speed, the step or the crowd,
+and the world refuses values it cannot step."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import ballpit
+
+BOX = 2.0  # m, a closed cube from (−1, 0, −1) to (1, 2, 1)
+
+
+def closed_box(world: ballpit.World, side: float = BOX, restitution: float = 1.0, friction: float = 0.5):
+    half = side / 2
+    walls = [
+        ((0, 1, 0), (0, 0, 0)),
+        ((0, -1, 0), (0, side, 0)),
+        ((1, 0, 0), (-half, half, 0)),
+        ((-1, 0, 0), (half, half, 0)),
+        ((0, 0, 1), (0, half, -half)),
+        ((0, 0, -1), (0, half, half)),
+    ]
+    for normal, position in walls:
+        world.add_plane(position=position, normal=normal, restitution=restitution, friction=friction)
+
+
+def inside(world: ballpit.World, side: float = BOX) -> bool:
+    x = world.spheres.positions
+    half = side / 2
+    return bool(
+        np.all((np.abs(x[:, 0]) <= half) & (x[:, 1] >= 0) & (x[:, 1] <= side) & (np.abs(x[:, 2]) <= half))
+    )
+
+
+def hot_gas(seed: int, speed: float, n: int = 150, r: float = 0.08) -> ballpit.World:
+    """``n`` balls on a jittered grid in the box, each moving at up to ``speed`` in a random direction."""
+    rng = np.random.default_rng(seed)
+    world = ballpit.World()
+    closed_box(world)
+    k = int(np.ceil(n ** (1 / 3)))
+    cells = np.stack(np.meshgrid(*[np.arange(k)] * 3, indexing="ij"), -1).reshape(-1, 3)[:n]
+    spacing = (BOX - 2 * r) / k
+    positions = (cells + 0.5) * spacing + (-BOX / 2 + r, r, -BOX / 2 + r)
+    positions += rng.uniform(-1, 1, positions.shape) * 0.45 * (spacing - 2 * r)
+    velocity = rng.normal(size=(n, 3))
+    velocity *= (speed * rng.uniform(0.3, 1.0, n) / np.linalg.norm(velocity, axis=1))[:, None]
+    world.add_spheres(positions, radius=r, velocity=velocity, restitution=1.0, friction=0.5)
+    return world
+
+
+@pytest.mark.parametrize(("seed", "speed"), [(0, 20.0), (1, 30.0), (2, 30.0)])
+def test_no_ball_leaves_a_closed_box_of_hot_gas_with_crowded_steps_on(seed, speed):
+    world = hot_gas(seed, speed)
+    world.crowd_limit = 4  # most steps with impacts are taken whole, with speculative contacts
+    for _ in range(96):
+        world.step(1 / 240)
+        assert inside(world)
+    assert world.crowded_steps > 10
+
+
+def test_a_ball_hit_hard_in_a_crowded_step_does_not_pass_through_the_floor():
+    # The lower ball was 5 cm above the floor, out of the speculative contacts' reach, when the upper
+    # one hit it at 40 m/s: it once left the step at −40 m/s and came out 10 m below the floor.
+    world = ballpit.World()
+    world.crowd_limit = 0  # every step with a meeting is crowded
+    world.add_plane(restitution=1.0)
+    r = 0.08
+    low = world.add_sphere(position=(0, r + 0.05, 0), radius=r)
+    world.add_sphere(position=(0, 3 * r + 0.06, 0), radius=r, velocity=(0, -40, 0))
+    for _ in range(60):
+        world.step(1 / 240)
+        assert world.spheres.positions[:, 1].min() >= r * 0.9  # never more than 10 % into the floor
+    assert world.crowded_steps >= 1 and low.position[1] > r
+
+
+@pytest.mark.parametrize(("velocity", "dt"), [((5000.0, 3000.0, 1000.0), 10.0), ((1e7, 3e6, 1e6), 1 / 240)])
+def test_no_speed_and_no_step_size_tunnels_out_of_a_box(velocity, dt):
+    # Far more impacts than a step may be split into: the rest of the step is finished conservatively.
+    world = ballpit.World(gravity=(0, 0, 0))
+    closed_box(world, side=4.0, friction=0.0)
+    world.add_sphere(position=(0, 2, 0), radius=0.1, velocity=velocity)
+    world.step(dt)
+    assert inside(world, side=4.0)
+
+
+def test_pushing_apart_balls_added_at_one_point_never_moves_them_through_a_plane():
+    world = ballpit.World()
+    world.add_plane()
+    world.add_spheres(np.tile([0.0, 1.0, 0.0], (100, 1)), radius=0.1)
+    for _ in range(10):
+        world.step(1 / 240)
+        assert world.spheres.positions[:, 1].min() > 0.0  # every centre stays above the floor
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("velocity", (0, -2e154, 0)), ("position", (1e300, 0, 0)), ("angular_velocity", (0, 0, 1e200))],
+)
+def test_values_beyond_what_the_engine_can_step_are_refused_by_name(field, value):
+    world = ballpit.World()
+    with pytest.raises(ValueError, match=field):
+        world.add_sphere(**{field: value})
+    ball = world.add_sphere()
+    with pytest.raises(ValueError, match=field):
+        setattr(ball, field, value)
+    column = {"velocity": world.spheres.velocities, "position": world.spheres.positions,
+              "angular_velocity": world.spheres.angular_velocities}[field]  # fmt: skip
+    column[0] = value  # straight into the arrays: the step refuses, naming the ball and the field
+    with pytest.raises(ValueError, match=rf"sphere #0 has beyond .* {field}"):
+        world.step(1 / 240)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [("radius", 1e-300), ("radius", 1e308), ("mass", 1e-320), ("mass", 1e300)]
+)
+def test_radius_and_mass_whose_inverses_cannot_be_stored_are_refused(key, value):
+    world = ballpit.World()
+    with pytest.raises(ValueError, match=key):
+        world.add_sphere(**{key: value})
+    with pytest.raises(ValueError, match=key):
+        world.add_spheres([[0, 0, 0]], **{key: value})
+
+
+def test_a_normal_with_huge_components_keeps_its_direction():
+    plane = ballpit.World().add_plane(normal=(1e308, 1e308, 0))
+    assert plane.normal == pytest.approx(np.array([1, 1, 0]) / np.sqrt(2))
+
+
+def test_solver_iterations_and_time_are_validated():
+    world = ballpit.World()
+    for bad in (-1, 0, 2.5, True):
+        with pytest.raises(ValueError, match="solver_iterations"):
+            world.solver_iterations = bad
+    with pytest.raises(ValueError, match="time"):
+        world.time = float("nan")
+    with pytest.raises(TypeError, match="hollow"):
+        world.add_spheres([[0, 0, 0], [1, 0, 0]], hollow=["a", "b"])
+
+
+def test_mass_and_radius_columns_are_read_only():
+    world = ballpit.World()
+    world.add_sphere()
+    with pytest.raises(ValueError):
+        world.spheres.radii[:] = -1
+    with pytest.raises(ValueError):
+        world.spheres.masses[:] = 2.0
