@@ -153,6 +153,13 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escap
     assert shot and Path(shot.group(1)).is_file(), out
 
 
+@pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
+def test_plus_and_minus_typed_on_a_real_keyboard_change_the_time_scale_every_time(xvfb, tmp_path):
+    # Shift is let go before "=": X reports the release as EQUAL while the press was PLUS
+    r = run_scenario(xvfb, "plus_minus_x_keys", tmp_path)
+    assert r["scales"] == [2.0, 4.0, 8.0, 4.0, 2.0, 4.0, 2.0, 1.0]
+
+
 def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
     code = "import sys; from ballpit.viewer.app import run; sys.exit(run())"
     for display in (None, ":12345"):  # no DISPLAY at all; a DISPLAY with no server behind it

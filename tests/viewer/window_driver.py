@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -63,6 +65,12 @@ def press(viewer: Viewer, name: str, modifiers: int = 0, frames: int = 1) -> Non
     pump(viewer, frames)
 
 
+def type_text(viewer: Viewer, text: str, frames: int = 1) -> None:
+    """Type text (what pyglet's ``on_text`` delivers) through the window's event queue."""
+    viewer.window.dispatch_event("on_text", text)
+    pump(viewer, frames)
+
+
 def hold(viewer: Viewer, names: list[str], frames: int) -> None:
     """Hold keys down for ``frames`` frames of 1/60 s, then release them."""
     from pyglet.window import key
@@ -92,6 +100,27 @@ def pump_until(viewer: Viewer, condition, timeout: float = 10.0) -> None:
     end = time.perf_counter() + timeout
     while not condition() and time.perf_counter() < end and not viewer.closed:
         viewer.pump()
+
+
+def xdotool(*args: str) -> str:
+    """Real X input: xdotool sends key and pointer events through the X server (XTEST)."""
+    out = subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=20, env=os.environ)
+    return out.stdout.strip()
+
+
+def settle(viewer: Viewer, frames: int = 6) -> None:
+    """Let the X server deliver what xdotool sent: pump frames with short pauses."""
+    for _ in range(frames):
+        time.sleep(0.03)
+        viewer.pump(FRAME)
+
+
+def point_at(viewer: Viewer) -> None:
+    """Put the pointer over the window: with no window manager, key input goes where the pointer is."""
+    viewer.window.activate()
+    settle(viewer)
+    xdotool("mousemove", "--window", str(viewer.window._window), "20", "20")
+    settle(viewer)
 
 
 def positions(viewer: Viewer) -> list:
@@ -225,10 +254,10 @@ def keys(workdir: Path) -> dict:
     for name in ("_1", "_2", "_3"):
         press(viewer, name)
         out[f"integrator{name}"] = sim.world.integrator
-    press(viewer, "EQUAL")
+    type_text(viewer, "+")
     out["faster"] = sim.time_scale
-    press(viewer, "MINUS")
-    press(viewer, "MINUS")
+    type_text(viewer, "-")
+    type_text(viewer, "-")
     out["slower"] = sim.time_scale
     press(viewer, "X", frames=20)
     for name in ("C", "V", "T"):
@@ -250,7 +279,28 @@ def keys(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (title, drop, fly, pause_step_reset, broken_reload, keys)}
+def plus_minus_x_keys(workdir: Path) -> dict:
+    """+ typed as a real user does: Shift down, = down, Shift up first, = up; three times, then − twice
+    and the keypad's + and −."""
+    viewer = open_viewer(world=balls_world())
+    pump(viewer, 3)
+    point_at(viewer)
+    scales = []
+    for _ in range(3):
+        for args in (("keydown", "shift"), ("keydown", "equal"), ("keyup", "shift"), ("keyup", "equal")):
+            xdotool(*args)
+        settle(viewer)
+        scales.append(viewer.sim.time_scale)
+    for name in ("minus", "minus", "KP_Add", "KP_Subtract", "KP_Subtract"):
+        xdotool("key", name)
+        settle(viewer)
+        scales.append(viewer.sim.time_scale)
+    return {"scales": scales}
+
+
+SCENARIOS = {
+    f.__name__: f for f in (title, drop, fly, pause_step_reset, broken_reload, keys, plus_minus_x_keys)
+}
 
 
 def main() -> None:

@@ -183,6 +183,12 @@ class Viewer:
             self.perform(action)
         return True  # handled: stops pyglet's default "Esc closes the window"
 
+    def on_text(self, text: str) -> bool:
+        action = controls.action_for_text(text)
+        if action is not None:
+            self.perform(action)
+        return True
+
     def on_key_release(self, symbol: int, modifiers: int) -> bool:
         from pyglet.window import key
 

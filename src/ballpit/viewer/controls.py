@@ -1,8 +1,11 @@
 """Input → action mapping for the viewer, kept free of pyglet and GL so it is unit-testable.
 
 Keys are named as in ``pyglet.window.key`` (``key.symbol_string(symbol)``: "X", "SPACE", "_1", "F5",
-"NUM_ADD", ...). The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of
-the F1 overlay and is built from the same bindings.
+...). + and − are read from the typed text instead (``TEXT_ACTIONS``): "+" is Shift+"=" on most layouts,
+and when Shift is let go first X reports the release as EQUAL, so pyglet still believes PLUS is held and
+swallows the next press; the text event arrives every time, from the main keys and the keypad alike.
+The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of the F1 overlay
+and is built from the same bindings.
 """
 
 from __future__ import annotations
@@ -49,13 +52,6 @@ KEY_ACTIONS: dict[str, Action] = {
     "NUM_2": Action.RK2,
     "_3": Action.RK4,
     "NUM_3": Action.RK4,
-    # "+" is Shift+"=" on most layouts and arrives as EQUAL.
-    "EQUAL": Action.FASTER,
-    "PLUS": Action.FASTER,
-    "NUM_ADD": Action.FASTER,
-    "MINUS": Action.SLOWER,
-    "UNDERSCORE": Action.SLOWER,
-    "NUM_SUBTRACT": Action.SLOWER,
     "TAB": Action.CAPTURE_MOUSE,
     "ESCAPE": Action.ESCAPE,
     "C": Action.CONTACTS,
@@ -67,6 +63,15 @@ KEY_ACTIONS: dict[str, Action] = {
 }
 
 CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
+
+# Typed text → action. "=" is the + key without Shift, "_" the − key with it.
+TEXT_ACTIONS: dict[str, Action] = {
+    "+": Action.FASTER,
+    "=": Action.FASTER,
+    "-": Action.SLOWER,
+    "_": Action.SLOWER,
+    "\u2212": Action.SLOWER,  # − (minus sign), as some layouts type it
+}
 
 INTEGRATOR_ACTIONS: dict[Action, str] = {Action.EULER: "euler", Action.RK2: "rk2", Action.RK4: "rk4"}
 
@@ -112,6 +117,11 @@ def action_for_key(name: str, ctrl: bool = False) -> Action | None:
     if ctrl:
         return CTRL_KEY_ACTIONS.get(name)
     return KEY_ACTIONS.get(name)
+
+
+def action_for_text(text: str) -> Action | None:
+    """The action bound to typed text (pyglet's ``on_text``), or None."""
+    return TEXT_ACTIONS.get(text)
 
 
 def fly_direction(held: Iterable[str]) -> np.ndarray:
