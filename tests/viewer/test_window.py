@@ -103,6 +103,29 @@ def test_integrator_time_scale_overlay_hud_help_screenshot_and_escape_keys(xvfb,
     assert r["after_second_escape"] == {"closed": True}
 
 
+def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
+    r = run_scenario(xvfb, "slopes_framing", tmp_path)
+    width, height = r["size"]
+    assert r["scene"] == "slopes.toml" and (width, height) == (1280, 720)
+    left, top, right, bottom = r["hud"]
+    # the featured top ball (purple, #9b5de5) is on screen from the first frame, not behind the HUD
+    first = np.array(r["first_frame"])
+    purple = (first[..., 2] > first[..., 0] + 40) & (first[..., 0] > first[..., 1] + 30)
+    rows, cols = np.nonzero(purple)
+    outside = ~((cols >= left) & (cols < right) & (rows >= top) & (rows < bottom))
+    assert outside.sum() > 20
+    # over the whole run, no ball is drawn under the HUD panel or off screen
+    track = np.array(r["track"])  # (frames, balls, (x, y, radius))
+    x, y, radius = track[..., 0], track[..., 1], track[..., 2]
+    under_hud = (x + radius > left) & (x - radius < right) & (y + radius > top) & (y - radius < bottom)
+    assert not under_hud.any()
+    assert (x - radius >= 0).all() and (x + radius <= width).all()
+    assert (y - radius >= 0).all() and (y + radius <= height).all()
+    # and the action fills the window from below the HUD to the bottom edge: no empty band of floor
+    assert (y + radius).max() > 0.9 * height
+    assert (y - radius).min() < 0.4 * height
+
+
 # ---------------------------------------------------------------------- the real event loop + X input
 def xdotool(display: str, *args: str) -> str:
     out = subprocess.run(

@@ -40,8 +40,8 @@ color = "#e0482f"
 OPENED: list[Viewer] = []
 
 
-def open_viewer(**kwargs: object) -> Viewer:
-    viewer = Viewer(size=(320, 180), **kwargs)
+def open_viewer(size: tuple[int, int] = (320, 180), **kwargs: object) -> Viewer:
+    viewer = Viewer(size=size, **kwargs)
     viewer.sim.step_budget = math.inf  # exact simulated time per frame even on a loaded machine
     OPENED.append(viewer)
     return viewer
@@ -298,8 +298,54 @@ def plus_minus_x_keys(workdir: Path) -> dict:
     return {"scales": scales}
 
 
+def screenshot(viewer: Viewer) -> np.ndarray:
+    """F12, then the PNG it wrote as an (H, W, 3) array: the window's real pixels, HUD included."""
+    from PIL import Image
+
+    press(viewer, "F12")
+    return np.asarray(Image.open(viewer.last_screenshot).convert("RGB")).astype(int)
+
+
+def hud_rectangle(viewer: Viewer) -> list[float]:
+    """The HUD panel as (left, top, right, bottom) in pixels from the window's top-left corner."""
+    panel, height = viewer.hud.panel, viewer.window.height
+    return [panel.x, height - panel.y - panel.height, panel.x + panel.width, height - panel.y]
+
+
+def slopes_framing(workdir: Path) -> dict:
+    """The bundled demo in a default-sized window: where its balls are drawn over the whole run."""
+    viewer = open_viewer(size=(1280, 720))  # no scene: the bundled slopes demo
+    pump(viewer, 2)
+    out: dict = {"size": [viewer.window.width, viewer.window.height], "scene": viewer.sim.appearance.name}
+    out["hud"] = hud_rectangle(viewer)
+    out["first_frame"] = screenshot(viewer).tolist()
+    press(viewer, "X")
+    radii = np.asarray(viewer.sim.world.spheres.radii)
+    track = []
+    for _ in range(300):  # 10 s of simulated time
+        pump(viewer, 1, dt=1.0 / 30.0)
+        pixels, depth = viewer.camera.project(viewer.sim.world.spheres.positions, *out["size"])
+        radius = (
+            radii / depth * (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
+        )
+        track.append(np.column_stack([pixels, radius]).tolist())
+    out["track"] = track  # per frame, per ball: (x, y, radius) in pixels
+    out["hud_after"] = hud_rectangle(viewer)
+    return out
+
+
 SCENARIOS = {
-    f.__name__: f for f in (title, drop, fly, pause_step_reset, broken_reload, keys, plus_minus_x_keys)
+    f.__name__: f
+    for f in (
+        title,
+        drop,
+        fly,
+        pause_step_reset,
+        broken_reload,
+        keys,
+        plus_minus_x_keys,
+        slopes_framing,
+    )
 }
 
 
