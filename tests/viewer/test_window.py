@@ -126,6 +126,37 @@ def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
     assert (y - radius).min() < 0.4 * height
 
 
+def overlap(a: list[float], b: list[float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
+    from ballpit.viewer.hud import PANEL_COLOR
+
+    r = run_scenario(xvfb, "help_beside_hud", tmp_path)
+    for name, w in r.items():
+        width, height = w["size"]
+        assert w["help_shown"], name
+        help_, text = w["help"], w["help_text"]
+        assert 0 <= help_[0] and help_[2] <= width and 0 <= help_[1] and help_[3] <= height, name
+        assert help_[0] <= text[0] and text[2] <= help_[2] and help_[1] <= text[1] and text[3] <= help_[3]
+        if w["hud_drawn"]:
+            assert not overlap(w["hud"], help_), name
+    # 1280x720 has room for both side by side, 900x700 one above the other; 700x420 only for the help
+    beside, above = r["1280x720"], r["900x700"]
+    assert beside["hud_drawn"] and beside["help"][0] >= beside["hud"][2]
+    assert above["hud_drawn"] and above["help"][1] >= above["hud"][3]
+    assert not r["700x420"]["hud_drawn"]
+    # in the real pixels: the HUD's bright text shows in its panel, the gap between the panels is scene
+    image = np.array(r["1280x720"]["pixels"])
+    hud, help_ = (np.array(r["1280x720"][k], dtype=int) for k in ("hud", "help"))
+    hud_pixels = image[hud[1] : hud[3], hud[0] : hud[2]]
+    assert (hud_pixels.min(axis=-1) > 200).sum() > 200  # its text
+    gap = image[help_[1] : help_[3], hud[2] + 2 : help_[0] - 2]
+    panel = np.array(PANEL_COLOR[:3])
+    assert gap.size and (np.abs(gap - panel).max(axis=-1) > 10).mean() > 0.5  # not a panel
+
+
 # ---------------------------------------------------------------------- the real event loop + X input
 def xdotool(display: str, *args: str) -> str:
     out = subprocess.run(

@@ -334,6 +334,39 @@ def slopes_framing(workdir: Path) -> dict:
     return out
 
 
+def panel_rectangle(viewer: Viewer, panel: object) -> list[float]:
+    """A pyglet rectangle as (left, top, right, bottom) in pixels from the window's top-left corner."""
+    height = viewer.window.height
+    return [panel.x, height - panel.y - panel.height, panel.x + panel.width, height - panel.y]
+
+
+def help_beside_hud(workdir: Path) -> dict:
+    """F1 in windows of several sizes, with the HUD shown: where the two panels are drawn."""
+    out: dict = {}
+    for size in ((1280, 720), (900, 700), (700, 420)):
+        viewer = open_viewer(size=size, world=balls_world())
+        pump(viewer, 2)
+        press(viewer, "F1", frames=2)
+        hud = viewer.hud
+        out[f"{size[0]}x{size[1]}"] = {
+            "size": [viewer.window.width, viewer.window.height],
+            "help_shown": hud.show_help,
+            "hud_drawn": hud.show_hud and not getattr(hud, "help_hides_hud", False),
+            "hud": panel_rectangle(viewer, hud.panel),
+            "help": panel_rectangle(viewer, hud.help_panel),
+            "help_text": [
+                hud.help_label.x - hud.help_label.content_width / 2,
+                viewer.window.height - hud.help_label.y - hud.help_label.content_height / 2,
+                hud.help_label.x + hud.help_label.content_width / 2,
+                viewer.window.height - hud.help_label.y + hud.help_label.content_height / 2,
+            ],
+            "pixels": screenshot(viewer).tolist() if size == (1280, 720) else None,
+        }
+        viewer.close()
+        viewer.pump()
+    return out
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
@@ -345,6 +378,7 @@ SCENARIOS = {
         keys,
         plus_minus_x_keys,
         slopes_framing,
+        help_beside_hud,
     )
 }
 
