@@ -95,9 +95,11 @@ def test_time_scale_doubles_and_halves_within_bounds():
     assert controls.slower(controls.TIME_SCALE_RANGE[0]) == controls.TIME_SCALE_RANGE[0]
 
 
-def test_escape_releases_a_captured_mouse_before_quitting():
+def test_escape_releases_a_captured_mouse_and_quits_only_when_pressed_again():
     assert controls.escape_outcome(mouse_captured=True) == "release"
-    assert controls.escape_outcome(mouse_captured=False) == "quit"
+    assert controls.escape_outcome(mouse_captured=True, armed=True) == "release"
+    assert controls.escape_outcome(mouse_captured=False) == "arm"
+    assert controls.escape_outcome(mouse_captured=False, armed=True) == "quit"
 
 
 def test_help_lists_every_control_of_the_design_table():

@@ -157,6 +157,18 @@ def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
     assert gap.size and (np.abs(gap - panel).max(axis=-1) > 10).mean() > 0.5  # not a panel
 
 
+def test_one_escape_asks_for_a_second_which_quits(xvfb, tmp_path):
+    r = run_scenario(xvfb, "double_escape", tmp_path)
+    hint = "press Esc again to quit"
+    assert r["first"] == {"closed": False, "message": hint}
+    assert r["later"] == {"closed": False, "message": ""}  # the hint goes after about 2 s
+    assert r["again"] == {"closed": False, "message": hint}  # so one Esc asks again
+    assert r["twice"] == {"closed": True}
+    before, first, later = (np.array(r[k]) for k in ("strip_before", "strip_first", "strip_later"))
+    assert (np.abs(first - before).max(axis=-1) > 60).sum() > 40  # the hint is drawn in the window
+    assert (np.abs(later - before).max(axis=-1) > 60).sum() == 0  # and gone again
+
+
 # ---------------------------------------------------------------------- the real event loop + X input
 def xdotool(display: str, *args: str) -> str:
     out = subprocess.run(
@@ -166,7 +178,7 @@ def xdotool(display: str, *args: str) -> str:
 
 
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
-def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escape(xvfb, tmp_path):
+def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_a_second_escape(xvfb, tmp_path):
     scene = tmp_path / "demo.toml"
     scene.write_text(GOOD_SCENE)
     code = "import sys, pathlib; from ballpit.viewer.app import run; sys.exit(run(pathlib.Path(sys.argv[1])))"
@@ -191,6 +203,9 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escap
         for keys in (["x"], ["F12"], ["Escape"]):
             xdotool(xvfb, "key", "--delay", "50", *keys)
             time.sleep(0.3)
+        time.sleep(0.5)
+        assert proc.poll() is None, "one Escape quit the viewer; it should ask for a second"
+        xdotool(xvfb, "key", "Escape")
         try:
             out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:

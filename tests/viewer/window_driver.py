@@ -367,6 +367,52 @@ def help_beside_hud(workdir: Path) -> dict:
     return out
 
 
+def grab(viewer: Viewer) -> np.ndarray:
+    """Draw a frame (no time passes) and read the window's pixels back before showing it, without F12
+    (which would flash its own message). (H, W, 3), top row first."""
+    from OpenGL import GL
+
+    viewer.window.switch_to()
+    viewer.frame(0.0)
+    width, height = viewer.window.get_framebuffer_size()
+    GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+    GL.glReadBuffer(GL.GL_BACK)
+    data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    viewer.window.flip()
+    return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1].astype(int)
+
+
+def shown_message(viewer: Viewer) -> str:
+    """The HUD's transient message if it is being drawn now, else ""."""
+    hud = viewer.hud
+    return hud.message if hud.message and time.perf_counter() < hud._message_until else ""
+
+
+def double_escape(workdir: Path) -> dict:
+    """Esc with nothing captured: the first asks for a second (in the HUD, for a while), the second
+    quits; once the hint has gone, one Esc asks again."""
+    from ballpit.viewer.hud import MARGIN
+
+    viewer = open_viewer(size=(640, 360), world=balls_world())
+    pump(viewer, 2)
+
+    def message_strip() -> np.ndarray:  # where the HUD's messages are drawn: along the bottom left
+        return grab(viewer)[-MARGIN - 30 :, :320]
+
+    out: dict = {"strip_before": message_strip().tolist()}
+    press(viewer, "ESCAPE")
+    out["first"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    out["strip_first"] = message_strip().tolist()
+    pump_for(viewer, 2.3)
+    out["later"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    out["strip_later"] = message_strip().tolist()
+    press(viewer, "ESCAPE")
+    out["again"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    press(viewer, "ESCAPE")
+    out["twice"] = {"closed": viewer.closed}
+    return out
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
@@ -379,6 +425,7 @@ SCENARIOS = {
         plus_minus_x_keys,
         slopes_framing,
         help_beside_hud,
+        double_escape,
     )
 }
 

@@ -70,6 +70,7 @@ class Viewer:
         self.hud = Hud(self.window)
         self.held: set[str] = set()
         self.mouse_captured = False
+        self._quit_armed_until = 0.0  # a second Esc before this time quits
         self.closed = False
         self._window_closed = False
         self.screenshot_requested = False
@@ -133,10 +134,7 @@ class Viewer:
         elif action is Action.CAPTURE_MOUSE:
             self.capture_mouse(not self.mouse_captured)
         elif action is Action.ESCAPE:
-            if controls.escape_outcome(self.mouse_captured) == "release":
-                self.capture_mouse(False)
-            else:
-                self.close()
+            self.escape()
         elif action is Action.CONTACTS:
             self.flags.contacts = not self.flags.contacts
         elif action is Action.VELOCITIES:
@@ -150,6 +148,19 @@ class Viewer:
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
         self._hud_at = 0.0  # refresh the HUD on the next frame
+
+    def escape(self) -> None:
+        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
+        until then the HUD asks for it."""
+        now = time.perf_counter()
+        outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
+        if outcome == "quit":
+            self.close()
+            return
+        if outcome == "release":
+            self.capture_mouse(False)
+        self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
+        self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 
     def reload(self) -> bool:
         ok = self.sim.reload()

@@ -30,7 +30,7 @@ class Action(Enum):
     FASTER = "faster time"
     SLOWER = "slower time"
     CAPTURE_MOUSE = "capture / release the mouse for looking"
-    ESCAPE = "release the mouse, or quit"
+    ESCAPE = "release the mouse; twice to quit"
     CONTACTS = "show contact points and normals"
     VELOCITIES = "show velocity arrows"
     TRAILS = "show trails"
@@ -91,6 +91,10 @@ SHIFT_SPEEDUP = 4.0
 SCROLL_FACTOR = 1.25
 FLY_SPEED_RANGE = (0.05, 500.0)
 
+# A second Esc within this many seconds quits; the HUD asks for it as long.
+QUIT_CONFIRM_SECONDS = 2.0
+QUIT_HINT = "press Esc again to quit"
+
 # Time scale (simulated seconds per real second) steps by a factor of 2 within these bounds.
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
 
@@ -105,7 +109,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
-    ("Esc", "release the mouse; again to quit"),
+    ("Esc", "release the mouse; Esc twice quits"),
     ("C / V / T", "contacts and normals / velocity arrows / trails"),
     ("H / F1", "HUD / this help"),
     ("F12", "screenshot PNG (path printed)"),
@@ -155,6 +159,10 @@ def slower(scale: float) -> float:
     return max(scale / 2.0, TIME_SCALE_RANGE[0])
 
 
-def escape_outcome(mouse_captured: bool) -> str:
-    """Esc releases a captured mouse first ("release"); otherwise it quits ("quit")."""
-    return "release" if mouse_captured else "quit"
+def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
+    """What Esc does: release a captured mouse ("release"); with nothing captured, quit only if Esc was
+    pressed in the last ``QUIT_CONFIRM_SECONDS`` (``armed``: "quit"), else ask for a second Esc ("arm").
+    Releasing the mouse arms the quit too: Esc releases it, Esc again quits."""
+    if mouse_captured:
+        return "release"
+    return "quit" if armed else "arm"

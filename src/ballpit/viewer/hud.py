@@ -141,11 +141,15 @@ class Hud:
             self.error_label.text = error
             self.layout()
 
-    def flash(self, message: str, now: float) -> None:
+    def flash(self, message: str, now: float, seconds: float = MESSAGE_SECONDS) -> None:
         """Show ``message`` for a few seconds."""
         self.message = message
         self.message_label.text = message
-        self._message_until = now + MESSAGE_SECONDS
+        self._message_until = now + seconds
+
+    def message_shown(self, now: float) -> str:
+        """The transient message drawn at time ``now``, or ""."""
+        return self.message if self.message and now < self._message_until else ""
 
     def draw(self, now: float) -> None:
         if self.show_help:
@@ -154,7 +158,7 @@ class Hud:
             self.batch.draw()
         if self.error:
             self.error_label.draw()
-        if self.message and now < self._message_until:
+        if self.message_shown(now):
             self.message_label.draw()
         if self.show_help:
             self.help_batch.draw()
