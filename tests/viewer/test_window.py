@@ -97,7 +97,8 @@ def test_integrator_time_scale_overlay_hud_help_screenshot_and_escape_keys(xvfb,
     assert r["draw_labels"] == ["planes", "balls", "world lines", "overlay lines"]
     assert r["hud_hidden"] and r["help_shown"]
     shot = Path(r["screenshot"])
-    assert shot.parent == tmp_path and shot.suffix == ".png" and shot.stat().st_size > 1000
+    assert shot.parent == tmp_path / "screenshots" and shot.suffix == ".png" and shot.stat().st_size > 1000
+    assert r["screenshot_message"] == f"screenshot saved to screenshots/{shot.name}"  # the HUD says where
     assert r["captured"]
     assert r["after_first_escape"] == {"captured": False, "closed": False}
     assert r["after_second_escape"] == {"closed": True}
@@ -220,6 +221,7 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_a_sec
     assert "Traceback" not in err, err
     shot = re.search(r"screenshot saved to (\S+\.png)", out)
     assert shot and Path(shot.group(1)).is_file(), out
+    assert Path(shot.group(1)).parent == tmp_path / "screenshots"
 
 
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")

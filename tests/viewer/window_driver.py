@@ -270,6 +270,7 @@ def keys(workdir: Path) -> dict:
     out["help_shown"] = viewer.hud.show_help
     press(viewer, "F12")
     out["screenshot"] = str(viewer.last_screenshot)
+    out["screenshot_message"] = shown_message(viewer)
     press(viewer, "TAB")
     out["captured"] = viewer.mouse_captured
     press(viewer, "ESCAPE")

@@ -19,6 +19,7 @@ TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
 FRAME_INTERVAL = 1.0 / 120.0  # redraw rate asked of pyglet's loop (vsync may cap it lower)
+SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
 
 
 def default_scene() -> Path:
@@ -286,7 +287,9 @@ class Viewer:
             self.window.set_caption(title(self.sim.appearance.name, self.fps))
 
     def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
-        """Save the back buffer (what this frame drew, HUD included) as a PNG; prints the path."""
+        """Save the back buffer (what this frame drew, HUD included) as a PNG in ``directory``
+        (``screenshots/`` in the current directory, created if need be); prints the path and shows it
+        in the HUD."""
         import numpy as np
         from OpenGL import GL
         from PIL import Image
@@ -295,7 +298,8 @@ class Viewer:
         GL.glReadBuffer(GL.GL_BACK)
         data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
         image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
-        directory = Path.cwd() if directory is None else directory
+        directory = Path.cwd() / SCREENSHOT_DIRECTORY if directory is None else directory
+        directory.mkdir(parents=True, exist_ok=True)
         stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
         path = directory / f"ballpit-{stamp}.png"
         n = 1
@@ -305,7 +309,10 @@ class Viewer:
         Image.fromarray(image).save(path)
         self.last_screenshot = path.resolve()
         print(f"screenshot saved to {self.last_screenshot}", flush=True)
-        self.hud.flash(f"screenshot saved to {self.last_screenshot}", time.perf_counter())
+        shown = self.last_screenshot
+        if shown.is_relative_to(Path.cwd()):
+            shown = shown.relative_to(Path.cwd())
+        self.hud.flash(f"screenshot saved to {shown}", time.perf_counter())
         return self.last_screenshot
 
     def pump(self, dt: float | None = None) -> None:

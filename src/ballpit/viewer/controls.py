@@ -112,7 +112,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("Esc", "release the mouse; Esc twice quits"),
     ("C / V / T", "contacts and normals / velocity arrows / trails"),
     ("H / F1", "HUD / this help"),
-    ("F12", "screenshot PNG (path printed)"),
+    ("F12", "screenshot PNG into screenshots/"),
 )
 
 
