@@ -49,8 +49,16 @@ void main() {
     vec3 hit = u_eye + ray * t;
     vec3 n = normalize(hit - c);
 
+    // One written depth serves every sample of the pixel, while a wall just in front of the ball has
+    // its own depth at each sample. The sphere's depth at the pixel centre would let the samples where
+    // the wall is a little farther away show the ball through it (coloured dots where balls rest
+    // against a wall). So write a depth the sphere does not come in front of anywhere in the pixel:
+    // the centre plus its screen-space slope, half a pixel each way, and as much again because the
+    // slope is a finite difference over a 2x2 block and underestimates a curved surface. The sphere
+    // only ever moves back, by about a pixel's worth of depth, so depth_greater still holds.
     vec4 clip = u_view_projection * vec4(hit, 1.0);
-    gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+    float depth = 0.5 * clip.z / clip.w + 0.5;
+    gl_FragDepth = clamp(depth + fwidth(depth), 0.0, 1.0);
 
     vec3 body = rotate_inverse(v_orientation, n);
     float ring = length(body.xz);

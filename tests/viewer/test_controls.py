@@ -18,11 +18,6 @@ DESIGN_TABLE = {
     "_1": Action.EULER,
     "_2": Action.RK2,
     "_3": Action.RK4,
-    "EQUAL": Action.FASTER,  # "+" arrives as Shift+EQUAL
-    "PLUS": Action.FASTER,
-    "NUM_ADD": Action.FASTER,
-    "MINUS": Action.SLOWER,
-    "NUM_SUBTRACT": Action.SLOWER,
     "TAB": Action.CAPTURE_MOUSE,
     "ESCAPE": Action.ESCAPE,
     "C": Action.CONTACTS,
@@ -37,6 +32,20 @@ DESIGN_TABLE = {
 @pytest.mark.parametrize(("name", "action"), DESIGN_TABLE.items())
 def test_each_key_of_the_design_table_maps_to_its_action(name, action):
     assert action_for_key(name) is action
+
+
+@pytest.mark.parametrize(
+    ("text", "action"),
+    [("+", Action.FASTER), ("=", Action.FASTER), ("-", Action.SLOWER), ("_", Action.SLOWER)],
+)
+def test_plus_and_minus_are_read_from_the_typed_text(text, action):
+    assert controls.action_for_text(text) is action
+
+
+@pytest.mark.parametrize("name", ["EQUAL", "PLUS", "NUM_ADD", "MINUS", "NUM_SUBTRACT"])
+def test_plus_and_minus_key_symbols_do_nothing_so_a_press_is_not_counted_twice(name):
+    assert action_for_key(name) is None
+    assert controls.action_for_text("x") is None
 
 
 def test_ctrl_r_reloads_while_plain_r_resets():
@@ -86,9 +95,11 @@ def test_time_scale_doubles_and_halves_within_bounds():
     assert controls.slower(controls.TIME_SCALE_RANGE[0]) == controls.TIME_SCALE_RANGE[0]
 
 
-def test_escape_releases_a_captured_mouse_before_quitting():
+def test_escape_releases_a_captured_mouse_and_quits_only_when_pressed_again():
     assert controls.escape_outcome(mouse_captured=True) == "release"
-    assert controls.escape_outcome(mouse_captured=False) == "quit"
+    assert controls.escape_outcome(mouse_captured=True, armed=True) == "release"
+    assert controls.escape_outcome(mouse_captured=False) == "arm"
+    assert controls.escape_outcome(mouse_captured=False, armed=True) == "quit"
 
 
 def test_help_lists_every_control_of_the_design_table():

@@ -98,3 +98,19 @@ def test_bad_render_arguments_raise_value_errors_naming_them(tmp_path, kwargs, m
         args["out"] = tmp_path / args["out"]
     with pytest.raises(ValueError, match=message):
         render_world(line_of_balls(), **args)
+
+
+@pytest.mark.parametrize("fps", [30, 24, 20, 7])
+def test_a_gif_plays_for_exactly_its_duration_at_any_frame_rate(offscreen, tmp_path, fps):
+    from ballpit.viewer.render import render
+
+    scene = tmp_path / "drop.toml"
+    scene.write_text(SCENE)
+    out = render(scene, tmp_path / "drop.gif", duration=1.0, fps=fps, size=(48, 32), progress=False)
+    with Image.open(out) as gif:
+        durations = [frame.info["duration"] for frame in ImageSequence.Iterator(gif)]
+    assert sum(durations) == 1000  # GIF delays are whole hundredths of a second, so exactly 100 of them
+    # Pillow merges identical frames; each written frame still starts within 5 ms of its true time
+    starts = np.cumsum([0, *durations[:-1]])
+    nearest = np.round(starts * fps / 1000) * 1000 / fps
+    assert np.abs(starts - nearest).max() <= 5

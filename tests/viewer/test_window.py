@@ -97,10 +97,77 @@ def test_integrator_time_scale_overlay_hud_help_screenshot_and_escape_keys(xvfb,
     assert r["draw_labels"] == ["planes", "balls", "world lines", "overlay lines"]
     assert r["hud_hidden"] and r["help_shown"]
     shot = Path(r["screenshot"])
-    assert shot.parent == tmp_path and shot.suffix == ".png" and shot.stat().st_size > 1000
+    assert shot.parent == tmp_path / "screenshots" and shot.suffix == ".png" and shot.stat().st_size > 1000
+    assert r["screenshot_message"] == f"screenshot saved to screenshots/{shot.name}"  # the HUD says where
     assert r["captured"]
     assert r["after_first_escape"] == {"captured": False, "closed": False}
     assert r["after_second_escape"] == {"closed": True}
+
+
+def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
+    r = run_scenario(xvfb, "slopes_framing", tmp_path)
+    width, height = r["size"]
+    assert r["scene"] == "slopes.toml" and (width, height) == (1280, 720)
+    left, top, right, bottom = r["hud"]
+    # the featured top ball (purple, #9b5de5) is on screen from the first frame, not behind the HUD
+    first = np.array(r["first_frame"])
+    purple = (first[..., 2] > first[..., 0] + 40) & (first[..., 0] > first[..., 1] + 30)
+    rows, cols = np.nonzero(purple)
+    outside = ~((cols >= left) & (cols < right) & (rows >= top) & (rows < bottom))
+    assert outside.sum() > 20
+    # over the whole run, no ball is drawn under the HUD panel or off screen
+    track = np.array(r["track"])  # (frames, balls, (x, y, radius))
+    x, y, radius = track[..., 0], track[..., 1], track[..., 2]
+    under_hud = (x + radius > left) & (x - radius < right) & (y + radius > top) & (y - radius < bottom)
+    assert not under_hud.any()
+    assert (x - radius >= 0).all() and (x + radius <= width).all()
+    assert (y - radius >= 0).all() and (y + radius <= height).all()
+    # and the action fills the window from below the HUD to the bottom edge: no empty band of floor
+    assert (y + radius).max() > 0.9 * height
+    assert (y - radius).min() < 0.4 * height
+
+
+def overlap(a: list[float], b: list[float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
+    from ballpit.viewer.hud import PANEL_COLOR
+
+    r = run_scenario(xvfb, "help_beside_hud", tmp_path)
+    for name, w in r.items():
+        width, height = w["size"]
+        assert w["help_shown"], name
+        help_, text = w["help"], w["help_text"]
+        assert 0 <= help_[0] and help_[2] <= width and 0 <= help_[1] and help_[3] <= height, name
+        assert help_[0] <= text[0] and text[2] <= help_[2] and help_[1] <= text[1] and text[3] <= help_[3]
+        if w["hud_drawn"]:
+            assert not overlap(w["hud"], help_), name
+    # 1280x720 has room for both side by side, 900x700 one above the other; 700x420 only for the help
+    beside, above = r["1280x720"], r["900x700"]
+    assert beside["hud_drawn"] and beside["help"][0] >= beside["hud"][2]
+    assert above["hud_drawn"] and above["help"][1] >= above["hud"][3]
+    assert not r["700x420"]["hud_drawn"]
+    # in the real pixels: the HUD's bright text shows in its panel, the gap between the panels is scene
+    image = np.array(r["1280x720"]["pixels"])
+    hud, help_ = (np.array(r["1280x720"][k], dtype=int) for k in ("hud", "help"))
+    hud_pixels = image[hud[1] : hud[3], hud[0] : hud[2]]
+    assert (hud_pixels.min(axis=-1) > 200).sum() > 200  # its text
+    gap = image[help_[1] : help_[3], hud[2] + 2 : help_[0] - 2]
+    panel = np.array(PANEL_COLOR[:3])
+    assert gap.size and (np.abs(gap - panel).max(axis=-1) > 10).mean() > 0.5  # not a panel
+
+
+def test_one_escape_asks_for_a_second_which_quits(xvfb, tmp_path):
+    r = run_scenario(xvfb, "double_escape", tmp_path)
+    hint = "press Esc again to quit"
+    assert r["first"] == {"closed": False, "message": hint}
+    assert r["later"] == {"closed": False, "message": ""}  # the hint goes after about 2 s
+    assert r["again"] == {"closed": False, "message": hint}  # so one Esc asks again
+    assert r["twice"] == {"closed": True}
+    before, first, later = (np.array(r[k]) for k in ("strip_before", "strip_first", "strip_later"))
+    assert (np.abs(first - before).max(axis=-1) > 60).sum() > 40  # the hint is drawn in the window
+    assert (np.abs(later - before).max(axis=-1) > 60).sum() == 0  # and gone again
 
 
 # ---------------------------------------------------------------------- the real event loop + X input
@@ -112,7 +179,7 @@ def xdotool(display: str, *args: str) -> str:
 
 
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
-def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escape(xvfb, tmp_path):
+def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_a_second_escape(xvfb, tmp_path):
     scene = tmp_path / "demo.toml"
     scene.write_text(GOOD_SCENE)
     code = "import sys, pathlib; from ballpit.viewer.app import run; sys.exit(run(pathlib.Path(sys.argv[1])))"
@@ -137,6 +204,9 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escap
         for keys in (["x"], ["F12"], ["Escape"]):
             xdotool(xvfb, "key", "--delay", "50", *keys)
             time.sleep(0.3)
+        time.sleep(0.5)
+        assert proc.poll() is None, "one Escape quit the viewer; it should ask for a second"
+        xdotool(xvfb, "key", "Escape")
         try:
             out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
@@ -151,6 +221,14 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_escap
     assert "Traceback" not in err, err
     shot = re.search(r"screenshot saved to (\S+\.png)", out)
     assert shot and Path(shot.group(1)).is_file(), out
+    assert Path(shot.group(1)).parent == tmp_path / "screenshots"
+
+
+@pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
+def test_plus_and_minus_typed_on_a_real_keyboard_change_the_time_scale_every_time(xvfb, tmp_path):
+    # Shift is let go before "=": X reports the release as EQUAL while the press was PLUS
+    r = run_scenario(xvfb, "plus_minus_x_keys", tmp_path)
+    assert r["scales"] == [2.0, 4.0, 8.0, 4.0, 2.0, 4.0, 2.0, 1.0]
 
 
 def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):

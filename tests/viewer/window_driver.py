@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -38,8 +40,8 @@ color = "#e0482f"
 OPENED: list[Viewer] = []
 
 
-def open_viewer(**kwargs: object) -> Viewer:
-    viewer = Viewer(size=(320, 180), **kwargs)
+def open_viewer(size: tuple[int, int] = (320, 180), **kwargs: object) -> Viewer:
+    viewer = Viewer(size=size, **kwargs)
     viewer.sim.step_budget = math.inf  # exact simulated time per frame even on a loaded machine
     OPENED.append(viewer)
     return viewer
@@ -60,6 +62,12 @@ def press(viewer: Viewer, name: str, modifiers: int = 0, frames: int = 1) -> Non
     symbol = getattr(key, name)
     viewer.window.dispatch_event("on_key_press", symbol, modifiers)
     viewer.window.dispatch_event("on_key_release", symbol, modifiers)
+    pump(viewer, frames)
+
+
+def type_text(viewer: Viewer, text: str, frames: int = 1) -> None:
+    """Type text (what pyglet's ``on_text`` delivers) through the window's event queue."""
+    viewer.window.dispatch_event("on_text", text)
     pump(viewer, frames)
 
 
@@ -92,6 +100,27 @@ def pump_until(viewer: Viewer, condition, timeout: float = 10.0) -> None:
     end = time.perf_counter() + timeout
     while not condition() and time.perf_counter() < end and not viewer.closed:
         viewer.pump()
+
+
+def xdotool(*args: str) -> str:
+    """Real X input: xdotool sends key and pointer events through the X server (XTEST)."""
+    out = subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=20, env=os.environ)
+    return out.stdout.strip()
+
+
+def settle(viewer: Viewer, frames: int = 6) -> None:
+    """Let the X server deliver what xdotool sent: pump frames with short pauses."""
+    for _ in range(frames):
+        time.sleep(0.03)
+        viewer.pump(FRAME)
+
+
+def point_at(viewer: Viewer) -> None:
+    """Put the pointer over the window: with no window manager, key input goes where the pointer is."""
+    viewer.window.activate()
+    settle(viewer)
+    xdotool("mousemove", "--window", str(viewer.window._window), "20", "20")
+    settle(viewer)
 
 
 def positions(viewer: Viewer) -> list:
@@ -225,10 +254,10 @@ def keys(workdir: Path) -> dict:
     for name in ("_1", "_2", "_3"):
         press(viewer, name)
         out[f"integrator{name}"] = sim.world.integrator
-    press(viewer, "EQUAL")
+    type_text(viewer, "+")
     out["faster"] = sim.time_scale
-    press(viewer, "MINUS")
-    press(viewer, "MINUS")
+    type_text(viewer, "-")
+    type_text(viewer, "-")
     out["slower"] = sim.time_scale
     press(viewer, "X", frames=20)
     for name in ("C", "V", "T"):
@@ -241,6 +270,7 @@ def keys(workdir: Path) -> dict:
     out["help_shown"] = viewer.hud.show_help
     press(viewer, "F12")
     out["screenshot"] = str(viewer.last_screenshot)
+    out["screenshot_message"] = shown_message(viewer)
     press(viewer, "TAB")
     out["captured"] = viewer.mouse_captured
     press(viewer, "ESCAPE")
@@ -250,7 +280,155 @@ def keys(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (title, drop, fly, pause_step_reset, broken_reload, keys)}
+def plus_minus_x_keys(workdir: Path) -> dict:
+    """+ typed as a real user does: Shift down, = down, Shift up first, = up; three times, then − twice
+    and the keypad's + and −."""
+    viewer = open_viewer(world=balls_world())
+    pump(viewer, 3)
+    point_at(viewer)
+    scales = []
+    for _ in range(3):
+        for args in (("keydown", "shift"), ("keydown", "equal"), ("keyup", "shift"), ("keyup", "equal")):
+            xdotool(*args)
+        settle(viewer)
+        scales.append(viewer.sim.time_scale)
+    for name in ("minus", "minus", "KP_Add", "KP_Subtract", "KP_Subtract"):
+        xdotool("key", name)
+        settle(viewer)
+        scales.append(viewer.sim.time_scale)
+    return {"scales": scales}
+
+
+def screenshot(viewer: Viewer) -> np.ndarray:
+    """F12, then the PNG it wrote as an (H, W, 3) array: the window's real pixels, HUD included."""
+    from PIL import Image
+
+    press(viewer, "F12")
+    return np.asarray(Image.open(viewer.last_screenshot).convert("RGB")).astype(int)
+
+
+def hud_rectangle(viewer: Viewer) -> list[float]:
+    """The HUD panel as (left, top, right, bottom) in pixels from the window's top-left corner."""
+    panel, height = viewer.hud.panel, viewer.window.height
+    return [panel.x, height - panel.y - panel.height, panel.x + panel.width, height - panel.y]
+
+
+def slopes_framing(workdir: Path) -> dict:
+    """The bundled demo in a default-sized window: where its balls are drawn over the whole run."""
+    viewer = open_viewer(size=(1280, 720))  # no scene: the bundled slopes demo
+    pump(viewer, 2)
+    out: dict = {"size": [viewer.window.width, viewer.window.height], "scene": viewer.sim.appearance.name}
+    out["hud"] = hud_rectangle(viewer)
+    out["first_frame"] = screenshot(viewer).tolist()
+    press(viewer, "X")
+    radii = np.asarray(viewer.sim.world.spheres.radii)
+    track = []
+    for _ in range(300):  # 10 s of simulated time
+        pump(viewer, 1, dt=1.0 / 30.0)
+        pixels, depth = viewer.camera.project(viewer.sim.world.spheres.positions, *out["size"])
+        radius = (
+            radii / depth * (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
+        )
+        track.append(np.column_stack([pixels, radius]).tolist())
+    out["track"] = track  # per frame, per ball: (x, y, radius) in pixels
+    out["hud_after"] = hud_rectangle(viewer)
+    return out
+
+
+def panel_rectangle(viewer: Viewer, panel: object) -> list[float]:
+    """A pyglet rectangle as (left, top, right, bottom) in pixels from the window's top-left corner."""
+    height = viewer.window.height
+    return [panel.x, height - panel.y - panel.height, panel.x + panel.width, height - panel.y]
+
+
+def help_beside_hud(workdir: Path) -> dict:
+    """F1 in windows of several sizes, with the HUD shown: where the two panels are drawn."""
+    out: dict = {}
+    for size in ((1280, 720), (900, 700), (700, 420)):
+        viewer = open_viewer(size=size, world=balls_world())
+        pump(viewer, 2)
+        press(viewer, "F1", frames=2)
+        hud = viewer.hud
+        out[f"{size[0]}x{size[1]}"] = {
+            "size": [viewer.window.width, viewer.window.height],
+            "help_shown": hud.show_help,
+            "hud_drawn": hud.show_hud and not getattr(hud, "help_hides_hud", False),
+            "hud": panel_rectangle(viewer, hud.panel),
+            "help": panel_rectangle(viewer, hud.help_panel),
+            "help_text": [
+                hud.help_label.x - hud.help_label.content_width / 2,
+                viewer.window.height - hud.help_label.y - hud.help_label.content_height / 2,
+                hud.help_label.x + hud.help_label.content_width / 2,
+                viewer.window.height - hud.help_label.y + hud.help_label.content_height / 2,
+            ],
+            "pixels": screenshot(viewer).tolist() if size == (1280, 720) else None,
+        }
+        viewer.close()
+        viewer.pump()
+    return out
+
+
+def grab(viewer: Viewer) -> np.ndarray:
+    """Draw a frame (no time passes) and read the window's pixels back before showing it, without F12
+    (which would flash its own message). (H, W, 3), top row first."""
+    from OpenGL import GL
+
+    viewer.window.switch_to()
+    viewer.frame(0.0)
+    width, height = viewer.window.get_framebuffer_size()
+    GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+    GL.glReadBuffer(GL.GL_BACK)
+    data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    viewer.window.flip()
+    return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1].astype(int)
+
+
+def shown_message(viewer: Viewer) -> str:
+    """The HUD's transient message if it is being drawn now, else ""."""
+    hud = viewer.hud
+    return hud.message if hud.message and time.perf_counter() < hud._message_until else ""
+
+
+def double_escape(workdir: Path) -> dict:
+    """Esc with nothing captured: the first asks for a second (in the HUD, for a while), the second
+    quits; once the hint has gone, one Esc asks again."""
+    from ballpit.viewer.hud import MARGIN
+
+    viewer = open_viewer(size=(640, 360), world=balls_world())
+    pump(viewer, 2)
+
+    def message_strip() -> np.ndarray:  # where the HUD's messages are drawn: along the bottom left
+        return grab(viewer)[-MARGIN - 30 :, :320]
+
+    out: dict = {"strip_before": message_strip().tolist()}
+    press(viewer, "ESCAPE")
+    out["first"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    out["strip_first"] = message_strip().tolist()
+    pump_for(viewer, 2.3)
+    out["later"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    out["strip_later"] = message_strip().tolist()
+    press(viewer, "ESCAPE")
+    out["again"] = {"closed": viewer.closed, "message": shown_message(viewer)}
+    press(viewer, "ESCAPE")
+    out["twice"] = {"closed": viewer.closed}
+    return out
+
+
+SCENARIOS = {
+    f.__name__: f
+    for f in (
+        title,
+        drop,
+        fly,
+        pause_step_reset,
+        broken_reload,
+        keys,
+        plus_minus_x_keys,
+        slopes_framing,
+        help_beside_hud,
+        double_escape,
+    )
+}
 
 
 def main() -> None:

@@ -19,6 +19,7 @@ TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
 FRAME_INTERVAL = 1.0 / 120.0  # redraw rate asked of pyglet's loop (vsync may cap it lower)
+SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
 
 
 def default_scene() -> Path:
@@ -70,6 +71,7 @@ class Viewer:
         self.hud = Hud(self.window)
         self.held: set[str] = set()
         self.mouse_captured = False
+        self._quit_armed_until = 0.0  # a second Esc before this time quits
         self.closed = False
         self._window_closed = False
         self.screenshot_requested = False
@@ -133,10 +135,7 @@ class Viewer:
         elif action is Action.CAPTURE_MOUSE:
             self.capture_mouse(not self.mouse_captured)
         elif action is Action.ESCAPE:
-            if controls.escape_outcome(self.mouse_captured) == "release":
-                self.capture_mouse(False)
-            else:
-                self.close()
+            self.escape()
         elif action is Action.CONTACTS:
             self.flags.contacts = not self.flags.contacts
         elif action is Action.VELOCITIES:
@@ -150,6 +149,19 @@ class Viewer:
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
         self._hud_at = 0.0  # refresh the HUD on the next frame
+
+    def escape(self) -> None:
+        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
+        until then the HUD asks for it."""
+        now = time.perf_counter()
+        outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
+        if outcome == "quit":
+            self.close()
+            return
+        if outcome == "release":
+            self.capture_mouse(False)
+        self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
+        self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 
     def reload(self) -> bool:
         ok = self.sim.reload()
@@ -182,6 +194,12 @@ class Viewer:
         if action is not None:
             self.perform(action)
         return True  # handled: stops pyglet's default "Esc closes the window"
+
+    def on_text(self, text: str) -> bool:
+        action = controls.action_for_text(text)
+        if action is not None:
+            self.perform(action)
+        return True
 
     def on_key_release(self, symbol: int, modifiers: int) -> bool:
         from pyglet.window import key
@@ -269,7 +287,9 @@ class Viewer:
             self.window.set_caption(title(self.sim.appearance.name, self.fps))
 
     def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
-        """Save the back buffer (what this frame drew, HUD included) as a PNG; prints the path."""
+        """Save the back buffer (what this frame drew, HUD included) as a PNG in ``directory``
+        (``screenshots/`` in the current directory, created if need be); prints the path and shows it
+        in the HUD."""
         import numpy as np
         from OpenGL import GL
         from PIL import Image
@@ -278,7 +298,8 @@ class Viewer:
         GL.glReadBuffer(GL.GL_BACK)
         data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
         image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
-        directory = Path.cwd() if directory is None else directory
+        directory = Path.cwd() / SCREENSHOT_DIRECTORY if directory is None else directory
+        directory.mkdir(parents=True, exist_ok=True)
         stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
         path = directory / f"ballpit-{stamp}.png"
         n = 1
@@ -288,7 +309,10 @@ class Viewer:
         Image.fromarray(image).save(path)
         self.last_screenshot = path.resolve()
         print(f"screenshot saved to {self.last_screenshot}", flush=True)
-        self.hud.flash(f"screenshot saved to {self.last_screenshot}", time.perf_counter())
+        shown = self.last_screenshot
+        if shown.is_relative_to(Path.cwd()):
+            shown = shown.relative_to(Path.cwd())
+        self.hud.flash(f"screenshot saved to {shown}", time.perf_counter())
         return self.last_screenshot
 
     def pump(self, dt: float | None = None) -> None:

@@ -1,8 +1,11 @@
 """Input → action mapping for the viewer, kept free of pyglet and GL so it is unit-testable.
 
 Keys are named as in ``pyglet.window.key`` (``key.symbol_string(symbol)``: "X", "SPACE", "_1", "F5",
-"NUM_ADD", ...). The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of
-the F1 overlay and is built from the same bindings.
+...). + and − are read from the typed text instead (``TEXT_ACTIONS``): "+" is Shift+"=" on most layouts,
+and when Shift is let go first X reports the release as EQUAL, so pyglet still believes PLUS is held and
+swallows the next press; the text event arrives every time, from the main keys and the keypad alike.
+The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of the F1 overlay
+and is built from the same bindings.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ class Action(Enum):
     FASTER = "faster time"
     SLOWER = "slower time"
     CAPTURE_MOUSE = "capture / release the mouse for looking"
-    ESCAPE = "release the mouse, or quit"
+    ESCAPE = "release the mouse; twice to quit"
     CONTACTS = "show contact points and normals"
     VELOCITIES = "show velocity arrows"
     TRAILS = "show trails"
@@ -49,13 +52,6 @@ KEY_ACTIONS: dict[str, Action] = {
     "NUM_2": Action.RK2,
     "_3": Action.RK4,
     "NUM_3": Action.RK4,
-    # "+" is Shift+"=" on most layouts and arrives as EQUAL.
-    "EQUAL": Action.FASTER,
-    "PLUS": Action.FASTER,
-    "NUM_ADD": Action.FASTER,
-    "MINUS": Action.SLOWER,
-    "UNDERSCORE": Action.SLOWER,
-    "NUM_SUBTRACT": Action.SLOWER,
     "TAB": Action.CAPTURE_MOUSE,
     "ESCAPE": Action.ESCAPE,
     "C": Action.CONTACTS,
@@ -67,6 +63,15 @@ KEY_ACTIONS: dict[str, Action] = {
 }
 
 CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
+
+# Typed text → action. "=" is the + key without Shift, "_" the − key with it.
+TEXT_ACTIONS: dict[str, Action] = {
+    "+": Action.FASTER,
+    "=": Action.FASTER,
+    "-": Action.SLOWER,
+    "_": Action.SLOWER,
+    "\u2212": Action.SLOWER,  # − (minus sign), as some layouts type it
+}
 
 INTEGRATOR_ACTIONS: dict[Action, str] = {Action.EULER: "euler", Action.RK2: "rk2", Action.RK4: "rk4"}
 
@@ -86,6 +91,10 @@ SHIFT_SPEEDUP = 4.0
 SCROLL_FACTOR = 1.25
 FLY_SPEED_RANGE = (0.05, 500.0)
 
+# A second Esc within this many seconds quits; the HUD asks for it as long.
+QUIT_CONFIRM_SECONDS = 2.0
+QUIT_HINT = "press Esc again to quit"
+
 # Time scale (simulated seconds per real second) steps by a factor of 2 within these bounds.
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
 
@@ -100,10 +109,10 @@ HELP: tuple[tuple[str, str], ...] = (
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
-    ("Esc", "release the mouse; again to quit"),
+    ("Esc", "release the mouse; Esc twice quits"),
     ("C / V / T", "contacts and normals / velocity arrows / trails"),
     ("H / F1", "HUD / this help"),
-    ("F12", "screenshot PNG (path printed)"),
+    ("F12", "screenshot PNG into screenshots/"),
 )
 
 
@@ -112,6 +121,11 @@ def action_for_key(name: str, ctrl: bool = False) -> Action | None:
     if ctrl:
         return CTRL_KEY_ACTIONS.get(name)
     return KEY_ACTIONS.get(name)
+
+
+def action_for_text(text: str) -> Action | None:
+    """The action bound to typed text (pyglet's ``on_text``), or None."""
+    return TEXT_ACTIONS.get(text)
 
 
 def fly_direction(held: Iterable[str]) -> np.ndarray:
@@ -145,6 +159,10 @@ def slower(scale: float) -> float:
     return max(scale / 2.0, TIME_SCALE_RANGE[0])
 
 
-def escape_outcome(mouse_captured: bool) -> str:
-    """Esc releases a captured mouse first ("release"); otherwise it quits ("quit")."""
-    return "release" if mouse_captured else "quit"
+def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
+    """What Esc does: release a captured mouse ("release"); with nothing captured, quit only if Esc was
+    pressed in the last ``QUIT_CONFIRM_SECONDS`` (``armed``: "quit"), else ask for a second Esc ("arm").
+    Releasing the mouse arms the quit too: Esc releases it, Esc again quits."""
+    if mouse_captured:
+        return "release"
+    return "quit" if armed else "arm"

@@ -1,7 +1,9 @@
 """The HUD (H), the key help (F1), transient messages and the scene error, drawn with pyglet text.
 
 ``hud_lines`` builds the HUD text from a Simulation without GL so it can be tested; ``Hud`` lays the
-labels out in the window's top-left corner (help centred, errors along the bottom).
+labels out: the HUD panel in the window's top-left corner, errors and messages along the bottom, and
+the help centred where it does not cover the HUD panel (beside it, else below it; only a window too
+small for both shows the help alone).
 """
 
 from __future__ import annotations
@@ -61,6 +63,8 @@ class Hud:
         self.error = ""
         self.message = ""
         self._message_until = 0.0
+        self.help_hides_hud = False  # the window has no room for both: the help is drawn alone
+        self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
         self.label = pyglet.text.Label(
             "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=460,
@@ -89,16 +93,39 @@ class Hud:
         self.message_label.x = MARGIN
         self.message_label.y = MARGIN + (self.error_label.content_height + 6 if self.error else 0)
         self._fit_panel()
-        self.help_label.x, self.help_label.y = w // 2, h // 2
-        hw, hh = self.help_label.content_width + 40, self.help_label.content_height + 30
-        self.help_panel.position = (w // 2 - hw // 2, h // 2 - hh // 2)
-        self.help_panel.width, self.help_panel.height = hw, hh
 
     def _fit_panel(self) -> None:
         h = self.window.height
         pw, ph = self.label.content_width + 14, self.label.content_height + 10
         self.panel.position = (MARGIN, h - MARGIN - ph)
         self.panel.width, self.panel.height = pw, ph
+        self._place_help()
+
+    def _place_help(self) -> None:
+        """Put the help panel where it does not cover the HUD panel: centred in the window if it is
+        clear of it there, else in the room right of it, else below it; if the window has room for
+        none of these the help is drawn alone (``help_hides_hud``)."""
+        w, h = self.window.width, self.window.height
+        panel = self.panel
+        key = (w, h, self.show_hud, panel.x, panel.y, panel.width, panel.height)
+        if key == self._help_layout_key:
+            return
+        self._help_layout_key = key
+        hw, hh = self.help_label.content_width + 40, self.help_label.content_height + 30
+        x = w // 2 - hw // 2
+        y = min(max(h // 2 - hh // 2, MARGIN), h - MARGIN - hh)  # centred, kept on screen if it fits
+        hud_right, hud_bottom = panel.x + panel.width + MARGIN, panel.y - MARGIN
+        self.help_hides_hud = False
+        if self.show_hud and x < hud_right and y + hh > hud_bottom:  # centred, it would cover the HUD
+            if hud_right + hw <= w - MARGIN:  # beside the HUD, centred in the room right of it
+                x = hud_right + (w - MARGIN - hud_right - hw) // 2
+            elif hh <= hud_bottom - MARGIN:  # below the HUD
+                y = min(y, hud_bottom - hh)
+            else:
+                self.help_hides_hud = True
+        self.help_panel.position = (x, y)
+        self.help_panel.width, self.help_panel.height = hw, hh
+        self.help_label.x, self.help_label.y = x + hw // 2, y + hh // 2
 
     def set_text(self, lines: list[str]) -> None:
         text = "\n".join(lines)
@@ -114,18 +141,24 @@ class Hud:
             self.error_label.text = error
             self.layout()
 
-    def flash(self, message: str, now: float) -> None:
+    def flash(self, message: str, now: float, seconds: float = MESSAGE_SECONDS) -> None:
         """Show ``message`` for a few seconds."""
         self.message = message
         self.message_label.text = message
-        self._message_until = now + MESSAGE_SECONDS
+        self._message_until = now + seconds
+
+    def message_shown(self, now: float) -> str:
+        """The transient message drawn at time ``now``, or ""."""
+        return self.message if self.message and now < self._message_until else ""
 
     def draw(self, now: float) -> None:
-        if self.show_hud:
+        if self.show_help:
+            self._place_help()  # H may have shown or hidden the HUD since
+        if self.show_hud and not (self.show_help and self.help_hides_hud):
             self.batch.draw()
         if self.error:
             self.error_label.draw()
-        if self.message and now < self._message_until:
+        if self.message_shown(now):
             self.message_label.draw()
         if self.show_help:
             self.help_batch.draw()

@@ -8,6 +8,7 @@ directory (existing, ending in ``/`` or without a suffix) numbered PNG frames ``
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import sys
@@ -89,6 +90,18 @@ def gif_palette(sample: np.ndarray, sphere_colors: np.ndarray, ramps: int = 8, s
     palette = Image.new("P", (1, 1))
     palette.putpalette(entries)
     return palette
+
+
+def gif_durations(frames: int, fps: float) -> list[int]:
+    """Per-frame GIF delays in milliseconds that keep the animation on time.
+
+    GIF stores delays in whole hundredths of a second, so 1/30 s cannot be written as such (Pillow
+    truncates 33 ms to 30, and a 30 fps GIF played 11 % fast). Frame i starts at round(100·i/fps)
+    hundredths instead: the delays alternate (30 and 40 ms at 30 fps), every frame starts within
+    5 ms of its true time and the total is exact to the hundredth.
+    """
+    starts = [round(100 * i / fps) for i in range(frames + 1)]
+    return [10 * (b - a) for a, b in itertools.pairwise(starts)]
 
 
 def _output_kind(out: Path, raw: str) -> str:
@@ -180,7 +193,12 @@ def render_world(
                 images.append(Image.fromarray(last).quantize(palette=palette, dither=Image.Dither.NONE))
     if kind == "gif":
         images[0].save(
-            out, save_all=True, append_images=images[1:], duration=round(1000.0 / fps), loop=0, disposal=1
+            out,
+            save_all=True,
+            append_images=images[1:],
+            duration=gif_durations(len(images), fps),
+            loop=0,
+            disposal=1,
         )
     elif kind == "png":
         Image.fromarray(last).save(out)

@@ -4,6 +4,11 @@ Import this only after ``backend.use_window()`` or ``backend.use_headless()`` an
 current. Per frame the CPU work is whole-array NumPy plus a handful of GL calls: the balls are one
 instance-buffer upload and one ``glDrawArraysInstanced`` whatever their number. Every draw goes through
 ``DrawLog`` so tests and benchmarks can see exactly which draw calls a frame made.
+
+Planes are drawn in two passes. Their front faces (the side the normal points to, where a scene puts
+its balls) are opaque and drawn first. Their back faces are the walls you look through, such as the
+near wall of a closed box seen from outside, so they are drawn see-through after the balls (blended,
+not writing depth). The second pass is skipped when the eye is on the front side of every plane.
 """
 
 from __future__ import annotations
@@ -114,6 +119,8 @@ class Renderer:
         for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10)]):
             _attribute(index, size, PLANE_STRIDE, offset)
         self.plane_vertices = 0
+        self._plane_centers = np.zeros((0, 3))
+        self._plane_normals = np.zeros((0, 3))
 
         # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
         self.line_vao = GL.glGenVertexArrays(1)
@@ -157,6 +164,7 @@ class Renderer:
         GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STATIC_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.plane_vertices = count * 6
+        self._plane_centers, self._plane_normals = centers, n
 
     def upload_balls(
         self,
@@ -209,6 +217,10 @@ class Renderer:
         program.set("u_background", self.background)
         program.set("u_fog_density", self.fog_density)
 
+    def seen_from_behind(self, eye: np.ndarray) -> np.ndarray:
+        """Which planes have the eye on their back side (drawn see-through), as a bool array."""
+        return np.einsum("ij,ij->i", eye[None, :] - self._plane_centers, self._plane_normals) < 0.0
+
     def draw(self, camera: Camera, width: int, height: int, multisample: bool = False) -> None:
         """Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport."""
         started = time.perf_counter()
@@ -223,13 +235,15 @@ class Renderer:
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LEQUAL)
         GL.glDepthMask(GL.GL_TRUE)
-        GL.glDisable(GL.GL_CULL_FACE)  # planes are two-sided; ball quads face the camera anyway
         GL.glDisable(GL.GL_BLEND)
 
-        if self.plane_vertices:
+        if self.plane_vertices:  # front faces, opaque
             self._common_uniforms(self.plane_program, view_projection, eye)
+            GL.glEnable(GL.GL_CULL_FACE)
+            GL.glCullFace(GL.GL_BACK)
             GL.glBindVertexArray(self.plane_vao)
             self.draws.arrays("planes", GL.GL_TRIANGLES, 0, self.plane_vertices)
+            GL.glDisable(GL.GL_CULL_FACE)  # ball quads face the camera anyway
 
         if self.ball_count:
             self._common_uniforms(self.ball_program, view_projection, eye)
@@ -240,6 +254,19 @@ class Renderer:
             self.draws.arrays_instanced("balls", GL.GL_TRIANGLE_STRIP, 0, 4, self.ball_count)
             if multisample:
                 GL.glDisable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
+
+        if self.plane_vertices and self.seen_from_behind(camera.position).any():  # back faces, see-through
+            self._common_uniforms(self.plane_program, view_projection, eye)
+            GL.glEnable(GL.GL_CULL_FACE)
+            GL.glCullFace(GL.GL_FRONT)
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
+            GL.glDepthMask(GL.GL_FALSE)
+            GL.glBindVertexArray(self.plane_vao)
+            self.draws.arrays("see-through planes", GL.GL_TRIANGLES, 0, self.plane_vertices)
+            GL.glDepthMask(GL.GL_TRUE)
+            GL.glDisable(GL.GL_BLEND)
+            GL.glDisable(GL.GL_CULL_FACE)
 
         if self.world_line_vertices or self.overlay_line_vertices:
             self.line_program.use()
