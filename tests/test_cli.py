@@ -152,10 +152,24 @@ def test_directory_and_binary_files(tmp_path):
         (["render", "scenes/slopes.toml", "--out", "x.gif", "--size", "big"], "--size"),
         (["render", "scenes/slopes.toml", "--out", "x.mp4"], "x.mp4"),
         (["nonsense"], "nonsense"),
+        (["render", "scenes/slopes.toml"], "--out"),
+        (["render", "scenes/slopes.toml", "--out", "x.gif", "--fps", "0"], "--fps"),
+        (["check"], "scene"),
+        (["check", "scenes/slopes.toml", "extra"], "extra"),
+        (["simulate", "scenes/slopes.toml", "--out"], "--out"),
+        (["bench", "--sizes", "abc"], "--sizes"),
+        (["bench", "--sizes", "0"], "--sizes"),
+        (["bench", "--steps", "0"], "--steps"),
+        (["bench", "--workload", "moon"], "--workload"),
+        (["bench", "--frobnicate"], "--frobnicate"),
+        (["bench", "--timeout", "-1"], "--timeout"),
+        (["simulate", "scenes/slopes.toml", "--integrator", "a\nb\x1b[31m"], "--integrator"),
+        (["simulate", "scenes/slopes.toml", "--out", "a\nb.txt"], "a\\nb.txt"),
     ],
 )
 def test_bad_options_exit_2_in_one_line(args, fragment):
-    assert_user_error(ballpit(*args), fragment)
+    line = assert_user_error(ballpit(*args), fragment)
+    assert line.startswith("ballpit") and "usage:" not in line and "\x1b" not in line
 
 
 def test_bad_output_paths_exit_2_and_leave_nothing(tmp_path):

@@ -23,6 +23,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .cli import OneLineParser, _count, _positive
+
 DT = 1 / 240
 RADIUS = 0.05
 SPACING = 0.11
@@ -229,7 +231,7 @@ def _sizes(text: str) -> list[int]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="ballpit bench", description=__doc__.splitlines()[0])
+    parser = OneLineParser(prog="ballpit bench", description=__doc__.splitlines()[0])
     parser.add_argument(
         "--workload",
         choices=("free", "pile", "settled", "all"),
@@ -237,16 +239,18 @@ def main(argv: list[str] | None = None) -> int:
         help="free flight; a grid falling into a box (the pile forming); or a pile already at rest",
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
-    parser.add_argument("--steps", type=int, default=None, help="steps to time (default: 1 s of simulation)")
+    parser.add_argument(
+        "--steps", type=_count, default=None, help="steps to time (default: 1 s of simulation)"
+    )
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
     parser.add_argument(
         "--pybullet-up-to",
-        type=int,
+        type=_count,
         metavar="N",
         help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
     )
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
-    parser.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per measurement")
+    parser.add_argument("--timeout", type=_positive, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )

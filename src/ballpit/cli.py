@@ -13,6 +13,7 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from . import __version__
 
@@ -20,11 +21,22 @@ COMMANDS = ("view", "check", "simulate", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse with a one-line error message (no usage block), still exit status 2."""
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with a one-line error message (no usage block), still exit status 2.
 
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+    Subcommand parsers made by ``add_subparsers`` are of the same class. Control characters in the
+    message (an option value holding a newline or a terminal escape) are shown escaped.
+    """
+
+    def error(self, message: str) -> NoReturn:  # type: ignore[override]
+        text = one_line(message, limit=500)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {text} (see '{self.prog} --help')\n")
+
+
+def one_line(text: str, limit: int | None = None) -> str:
+    """``text`` with control characters escaped (so it stays one line), shortened to ``limit`` if given."""
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _positive(text: str) -> float:
@@ -62,7 +74,7 @@ def _size(text: str) -> tuple[int, int]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    parser = _Parser(
+    parser = OneLineParser(
         prog="ballpit",
         description="Balls, slopes, spin and impacts: a physics sandbox with a viewer and a headless runner.",
         epilog="With no command, or just a scene file, ballpit opens the viewer.",
@@ -132,7 +144,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.handler(args) or EXIT_OK)
     except (SceneError, OutputError) as e:
-        print(f"ballpit: {e}", file=sys.stderr)
+        print(f"ballpit: {one_line(str(e))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("ballpit: interrupted", file=sys.stderr)
