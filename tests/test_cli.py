@@ -349,3 +349,34 @@ def test_scenes_lists_the_bundled_scenes():
     assert r.returncode == 0
     names = [line.split()[0] for line in r.stdout.splitlines()]
     assert {"slopes", "cradle", "billiards", "incline", "pile", "pile10k"} <= set(names)
+
+
+def test_a_run_of_more_than_a_billion_steps_is_refused_naming_the_numbers(tmp_path):
+    r = ballpit("simulate", "scenes/slopes.toml", "--dt", "1e-300", timeout=30)
+    assert_user_error(r, "--dt 1e-300", "10 s", "1e+301 steps", "limit is 1e+09")
+    scene = tmp_path / "tiny.toml"
+    scene.write_text("[world]\ntimestep = 1e-300\n\n[[sphere]]\nposition = [0, 1, 0]\n")
+    r = ballpit("simulate", scene, "--duration", "2", timeout=30)
+    assert_user_error(r, str(scene), "timestep 1e-300", "2e+300 steps", "limit is 1e+09")
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "1e300", "--dt", "1e-300", timeout=30)
+    assert_user_error(r, "inf steps")
+
+
+@pytest.mark.parametrize("option", ["--out", "--events"])
+def test_a_file_name_over_255_bytes_is_one_line(tmp_path, option):
+    long_name = "é" * 130 + ".csv"  # 264 bytes in UTF-8
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.01", option, tmp_path / long_name)
+    assert_user_error(r, option, "264 bytes", "limit is 255")
+    r = ballpit(
+        "simulate", "scenes/slopes.toml", "--duration", "0.01", option, tmp_path / ("a" * 300) / "x.npz"
+    )
+    assert_user_error(r, option, "300 bytes")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_name_of_255_bytes_is_written(tmp_path):
+    """The temporary file beside it must fit too, although its name is longer."""
+    name = "é" * 125 + "a.csv"  # 255 bytes
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.01", "--out", tmp_path / name, "-q")
+    assert r.returncode == 0, r.stderr
+    assert [p.name for p in tmp_path.iterdir()] == [name]

@@ -39,6 +39,10 @@ def one_line(text: str, limit: int | None = None) -> str:
     return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
 
 
+class UsageError(ValueError):
+    """A command line whose options are each fine but that cannot be run (a run of 10¹² steps)."""
+
+
 def _positive(text: str) -> float:
     try:
         x = float(text)
@@ -143,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     try:
         return int(args.handler(args) or EXIT_OK)
-    except (SceneError, OutputError) as e:
+    except (SceneError, OutputError, UsageError) as e:
         print(f"ballpit: {one_line(str(e))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
@@ -173,7 +177,7 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from .simulate import format_summary, run
+    from .simulate import MAX_STEPS, format_summary, run, step_count
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
     world = _load(args.scene)
@@ -182,6 +186,12 @@ def _simulate(args: argparse.Namespace) -> int:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
     duration = args.duration or info.duration or 10.0
+    if not step_count(duration, dt) <= MAX_STEPS:
+        source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
+        raise UsageError(
+            f"{source}: {duration:g} s in steps of {dt:g} s is {step_count(duration, dt):.3g} steps; "
+            f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"
+        )
     if args.out is not None and args.events is not None and args.out.resolve() == args.events.resolve():
         raise OutputError(f"{args.out}: --out and --events must be different files")
     writers: list = []

@@ -73,8 +73,28 @@ def energy(world: World, inertia: np.ndarray | None = None) -> Energy:
     return Energy(kinetic, potential)
 
 
+MAX_STEPS = 10**9  # a longer run is a mistake (a timestep of 1e-300 s), not a job: refused
+
+
+class TooManySteps(ValueError):
+    """A run of more than MAX_STEPS steps."""
+
+
+def step_count(duration: float, dt: float) -> float:
+    """How many steps ``duration`` takes at ``dt`` (a float: it may be astronomically large, or inf)."""
+    return math.ceil(duration / dt - 1e-9) if duration / dt < 2.0**62 else duration / dt
+
+
 def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
-    """Steps as (count, dt) runs that end exactly at ``duration``: whole steps, then any remainder."""
+    """Steps as (count, dt) runs that end exactly at ``duration``: whole steps, then any remainder.
+
+    Raises TooManySteps for a run of more than MAX_STEPS steps.
+    """
+    count = step_count(duration, dt)
+    if not count <= MAX_STEPS:
+        raise TooManySteps(
+            f"{duration:g} s in steps of {dt:g} s is {count:.3g} steps; the limit is {MAX_STEPS:.0e}"
+        )
     whole = math.floor(duration / dt + 1e-9)
     rest = duration - whole * dt
     plan = [(whole, dt)] if whole else []

@@ -27,17 +27,49 @@ class OutputError(ValueError):
     """An output path that cannot be written (bad suffix, missing directory, no permission)."""
 
 
+NAME_MAX = 255  # bytes in one file name on Linux, macOS and Windows file systems
+_TEMP_NAME = ".{name}.{pid}.partial"
+
+
+def shorten(path: Path | str, limit: int = 80) -> str:
+    """``path`` for a message: kept whole when short, else its start and end around an ellipsis."""
+    text = str(path)
+    return text if len(text) <= limit else f"{text[: limit // 2 - 2]}...{text[-(limit // 2 - 1) :]}"
+
+
+def check_name_lengths(path: Path, what: str) -> None:
+    """OutputError if a part of ``path`` is longer than a file name can be (NAME_MAX bytes)."""
+    for part in path.parts:
+        size = len(os.fsencode(part))
+        if size > NAME_MAX:
+            raise OutputError(
+                f"{shorten(path)}: {what}: a file name of {size} bytes is too long; the limit is {NAME_MAX}"
+            )
+
+
 def check_output_path(path: Path, what: str) -> str:
     """The output format (".csv" or ".npz") for ``path``, or OutputError saying what is wrong."""
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"{path}: {what} must end in .csv or .npz, not {suffix or 'no suffix'!r}")
-    if path.is_dir():
-        raise OutputError(f"{path}: {what} is a directory")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
+    check_name_lengths(path, what)
+    try:
+        if path.is_dir():
+            raise OutputError(f"{path}: {what} is a directory")
+        parent = path.parent if str(path.parent) else Path(".")
+        if not parent.is_dir():
+            raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
+    except OSError as e:
+        raise OutputError(f"{shorten(path)}: {what}: {e.strerror or e}") from None
     return suffix
+
+
+def temp_path(target: Path) -> Path:
+    """A hidden temporary name beside ``target`` (its name shortened if need be to fit NAME_MAX)."""
+    name, pid = target.name, os.getpid()
+    while len(os.fsencode(_TEMP_NAME.format(name=name, pid=pid))) > NAME_MAX:
+        name = name[:-1]
+    return target.with_name(_TEMP_NAME.format(name=name, pid=pid))
 
 
 class AtomicFile:
@@ -45,7 +77,7 @@ class AtomicFile:
 
     def __init__(self, target: Path, mode: str = "w") -> None:
         self.target = target
-        self.temp = target.with_name(f".{target.name}.{os.getpid()}.partial")
+        self.temp = temp_path(target)
         try:
             self.file: IO = open(self.temp, mode, encoding="utf-8" if "b" not in mode else None)
         except OSError as e:
