@@ -52,25 +52,17 @@ class RunSummary:
         return self.steps / self.wall_time if self.wall_time > 0 else math.inf
 
 
-def inertias(world: World) -> np.ndarray:
-    """Each ball's moment of inertia (kg·m²), read once through the public views."""
-    return np.array([s.inertia for s in world.spheres], dtype=float)
+def energy(world: World) -> Energy:
+    """The world's kinetic (½mv² + ½Iω²) and gravitational potential (−m g·x) energy."""
+    return Energy(world.kinetic_energy(), 0.0 + world.potential_energy())  # 0.0 +: no '-0'
 
 
-def energy(world: World, inertia: np.ndarray | None = None) -> Energy:
-    """Kinetic (½mv² + ½Iω²) and gravitational potential (−m g·x) energy of every ball."""
-    balls = world.spheres
-    if len(balls) == 0:
-        return Energy(0.0, 0.0)
-    inertia = inertias(world) if inertia is None else inertia
-    m = balls.masses
-    v = balls.velocities
-    w = balls.angular_velocities
-    kinetic = 0.5 * float(m @ np.einsum("ij,ij->i", v, v)) + 0.5 * float(
-        inertia @ np.einsum("ij,ij->i", w, w)
-    )
-    potential = 0.0 - float(m @ (balls.positions @ world.gravity))  # 0.0 -: no '-0' without gravity
-    return Energy(kinetic, potential)
+ROUNDING = 64 * np.finfo(float).eps  # energies smaller than this times the run's scale print as 0
+
+
+def tidy(value: float, scale: float) -> float:
+    """``value``, or 0.0 when it is zero to within rounding next to ``scale`` (the run's energies)."""
+    return 0.0 if abs(value) <= ROUNDING * scale else value
 
 
 MAX_STEPS = 10**9  # a longer run is a mistake (a timestep of 1e-300 s), not a job: refused
@@ -123,8 +115,7 @@ def run(
     plan = step_plan(duration, dt)
     total = sum(n for n, _ in plan)
     balls = world.spheres
-    inertia = inertias(world)
-    start_energy = energy(world, inertia)
+    start_energy = energy(world)
 
     def record() -> None:
         if trajectory is not None:
@@ -168,7 +159,7 @@ def run(
         sphere_sphere_contacts=int(counts[SPHERE_SPHERE]),
         records=trajectory.records if trajectory is not None else 0,
         energy_start=start_energy,
-        energy_end=energy(world, inertia),
+        energy_end=energy(world),
     )
 
 
@@ -176,13 +167,18 @@ def format_summary(summary: RunSummary, name: str, integrator: str, dt: float, n
     """The closing summary, a few short lines."""
     s = summary
     e0, e1 = s.energy_start, s.energy_end
+    scale = max(abs(e.kinetic) + abs(e.potential) for e in (e0, e1))
+
+    def j(value: float) -> str:
+        return f"{tidy(value, scale):.6g}"
+
     lines = [
         f"{name}: {n_balls} balls, {s.steps} steps of {dt * 1000:.4g} ms "
         f"({s.sim_time:g} s simulated, {integrator})",
         f"  wall time {s.wall_time:.3f} s, {s.steps_per_second:,.0f} steps/s",
         f"  contacts {s.contacts} "
         f"({s.sphere_plane_contacts} sphere-plane, {s.sphere_sphere_contacts} sphere-sphere)",
-        f"  energy start {e0.total:.6g} J (kinetic {e0.kinetic:.6g} + potential {e0.potential:.6g}), "
-        f"end {e1.total:.6g} J (kinetic {e1.kinetic:.6g} + potential {e1.potential:.6g})",
+        f"  energy start {j(e0.total)} J (kinetic {j(e0.kinetic)} + potential {j(e0.potential)}), "
+        f"end {j(e1.total)} J (kinetic {j(e1.kinetic)} + potential {j(e1.potential)})",
     ]
     return lines
