@@ -2,12 +2,18 @@
 
 Each writer fills a temporary file beside its target and renames it into place only when the run
 finishes, so a crash, a Ctrl+C or a bad option never leaves a truncated file that looks complete.
-Rows are buffered as arrays and formatted a chunk at a time with one ``%`` operation, not per row.
+Rows are buffered as arrays a chunk at a time and streamed to disk as the run goes, so memory does not
+grow with the duration: CSV text is formatted a chunk at a time with one ``%`` operation, not per row;
+for ``.npz``, each chunk's columns go to an unnamed scratch file, and ``commit`` copies them column by
+column into the archive's ``.npy`` members, a chunk at a time.
 """
 
 from __future__ import annotations
 
 import os
+import tempfile
+import zipfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO
 
@@ -92,11 +98,74 @@ class AtomicFile:
         self.temp.unlink(missing_ok=True)
 
 
+class ColumnSpool:
+    """Rows of float64 columns spooled to an unnamed scratch file, written out as ``.npy`` members.
+
+    Each chunk is stored column after column, so a column can be read back a chunk at a time. The
+    scratch file has no name (it is deleted as soon as it is made, or made without one), so nothing
+    of it can be left behind, whatever ends the process.
+    """
+
+    def __init__(self, names: tuple[str, ...], directory: Path) -> None:
+        self.names = names
+        self.file = tempfile.TemporaryFile(dir=directory)
+        self.chunks: list[tuple[int, int]] = []  # (byte offset, rows)
+        self.rows = 0
+
+    def add(self, rows: np.ndarray) -> None:
+        """Append (R, len(names)) rows."""
+        if len(rows) == 0:
+            return
+        self.chunks.append((self.file.tell(), len(rows)))
+        np.ascontiguousarray(rows.T, dtype=np.float64).tofile(self.file)
+        self.rows += len(rows)
+
+    def column(self, k: int):
+        """Column ``k``, one chunk at a time."""
+        for offset, rows in self.chunks:
+            self.file.seek(offset + k * rows * 8)
+            yield np.fromfile(self.file, dtype=np.float64, count=rows)
+
+    def write_npz(self, out: IO[bytes], convert: dict[str, tuple[np.dtype, Callable]]) -> None:
+        """Write every column to ``out`` as ``np.savez`` would (one stored ``<name>.npy`` member each).
+
+        ``convert`` gives a column's dtype and a function from float64 chunk to that dtype.
+        """
+        self.file.flush()
+        with zipfile.ZipFile(out, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as archive:
+            for k, name in enumerate(self.names):
+                dtype, cast = convert.get(name, (np.dtype(np.float64), None))
+                header = np.lib.format.header_data_from_array_1_0(np.empty(0, dtype))
+                header["shape"] = (self.rows,)
+                with archive.open(f"{name}.npy", "w", force_zip64=True) as member:  # as np.savez does
+                    np.lib.format.write_array_header_1_0(member, header)
+                    for chunk in self.column(k):
+                        member.write((chunk if cast is None else cast(chunk)).astype(dtype).tobytes())
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def _directory(path: Path) -> Path:
+    return path.parent if str(path.parent) else Path(".")
+
+
+_TRAJECTORY_TYPES = {"id": (np.dtype(np.int64), None)}
+_EVENT_TYPES = {
+    "kind": (
+        np.dtype(f"<U{max(map(len, KIND_NAMES))}"),
+        lambda code: np.asarray(KIND_NAMES)[code.astype(np.intp)],
+    ),
+    "a": (np.dtype(np.int64), None),
+    "b": (np.dtype(np.int64), None),
+}
+
+
 class TrajectoryWriter:
     """Every ball's state at the recorded times: one row per ball per record.
 
-    ``record`` copies the state into a preallocated buffer; full buffers are flushed as CSV text, or
-    kept as arrays for one ``.npz`` at the end.
+    ``record`` copies the state into a preallocated buffer; full buffers go to disk as CSV text, or
+    to the ``.npz``'s column spool.
     """
 
     def __init__(self, path: Path, n_balls: int) -> None:
@@ -109,7 +178,7 @@ class TrajectoryWriter:
         self.buffer[:, :, 1] = np.arange(n_balls)
         self.filled = 0
         self.records = 0
-        self.chunks: list[np.ndarray] = []
+        self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.row_format = ",".join(["%.9g", "%d"] + [_FLOAT] * (len(TRAJECTORY_COLUMNS) - 2)) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(TRAJECTORY_COLUMNS) + "\n")
@@ -128,22 +197,22 @@ class TrajectoryWriter:
 
     def _flush(self) -> None:
         rows = self.buffer[: self.filled].reshape(-1, len(TRAJECTORY_COLUMNS))
-        if self.format == ".csv":
+        if self.spool is None:
             self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
         else:
-            self.chunks.append(rows.copy())
+            self.spool.add(rows)
         self.filled = 0
 
     def commit(self) -> None:
         self._flush()
-        if self.format == ".npz":
-            rows = np.concatenate(self.chunks) if self.chunks else np.zeros((0, len(TRAJECTORY_COLUMNS)))
-            arrays = {name: rows[:, k] for k, name in enumerate(TRAJECTORY_COLUMNS)}
-            arrays["id"] = arrays["id"].astype(np.int64)
-            np.savez(self.out.file, **arrays)
+        if self.spool is not None:
+            self.spool.write_npz(self.out.file, _TRAJECTORY_TYPES)
+            self.spool.close()
         self.out.commit()
 
     def discard(self) -> None:
+        if self.spool is not None:
+            self.spool.close()
         self.out.discard()
 
 
@@ -156,8 +225,8 @@ class EventWriter:
         self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
         self.pending: list[Contacts] = []
         self.pending_rows = 0
-        self.chunks: list[Contacts] = []
         self.count = 0
+        self.spool = ColumnSpool(EVENT_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.row_format = ",".join(["%.9g", "%s", "%d", "%d"] + [_FLOAT] * 7) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(EVENT_COLUMNS) + "\n")
@@ -176,8 +245,16 @@ class EventWriter:
             return
         c = Contacts.concatenate(self.pending)
         self.pending, self.pending_rows = [], 0
-        if self.format == ".npz":
-            self.chunks.append(c)
+        if self.spool is not None:
+            rows = np.empty((len(c), len(EVENT_COLUMNS)))
+            rows[:, 0] = c.time
+            rows[:, 1] = c.kind
+            rows[:, 2] = c.a
+            rows[:, 3] = c.b
+            rows[:, 4:7] = c.point
+            rows[:, 7:10] = c.normal
+            rows[:, 10] = c.impulse
+            self.spool.add(rows)
             return
         rows = np.empty((len(c), len(EVENT_COLUMNS)), dtype=object)
         rows[:, 0] = c.time
@@ -191,23 +268,12 @@ class EventWriter:
 
     def commit(self) -> None:
         self._flush()
-        if self.format == ".npz":
-            c = Contacts.concatenate(self.chunks)
-            np.savez(
-                self.out.file,
-                time=c.time,
-                kind=np.asarray(KIND_NAMES)[c.kind],
-                a=c.a.astype(np.int64),
-                b=c.b.astype(np.int64),
-                x=c.point[:, 0],
-                y=c.point[:, 1],
-                z=c.point[:, 2],
-                nx=c.normal[:, 0],
-                ny=c.normal[:, 1],
-                nz=c.normal[:, 2],
-                impulse=c.impulse,
-            )
+        if self.spool is not None:
+            self.spool.write_npz(self.out.file, _EVENT_TYPES)
+            self.spool.close()
         self.out.commit()
 
     def discard(self) -> None:
+        if self.spool is not None:
+            self.spool.close()
         self.out.discard()
