@@ -37,13 +37,17 @@ spacing = 0.2
 """
 
 
-def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict]:
-    """The trajectory and event columns of a run, straight from World.step."""
+def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict, dict]:
+    """The trajectory, event and impact columns of a run, straight from World.step.
+
+    Impacts are the contacts whose pair (kind, a, b) was not among the step before's contacts.
+    """
     world = ballpit.load_scene(scene)
     balls = world.spheres
     n = len(balls)
     records: list[np.ndarray] = []
     contacts: list[Contacts] = []
+    impacts: list[Contacts] = []
 
     def record() -> None:
         row = np.empty((n, 15))
@@ -58,17 +62,27 @@ def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict]:
     record()
     plan = step_plan(duration, world.scene.timestep)
     total, done = sum(k for k, _ in plan), 0
+    before: set[tuple[int, int, int]] = set()
     for k, h in plan:
         for _ in range(k):
-            contacts.append(world.step(h))
+            step = world.step(h)
+            pairs = list(zip(step.kind.tolist(), step.a.tolist(), step.b.tolist(), strict=True))
+            new = np.array([pair not in before for pair in pairs], dtype=bool)
+            impacts.append(Contacts(**{f: getattr(step, f)[new] for f in Contacts.__dataclass_fields__}))
+            before = set(pairs)
+            contacts.append(step)
             done += 1
             if done % every == 0 or done == total:
                 record()
     rows = np.concatenate(records)
     trajectory = {name: rows[:, k] for k, name in enumerate(TRAJECTORY)}
     trajectory["id"] = trajectory["id"].astype(np.int64)
+    return trajectory, event_columns(contacts), event_columns(impacts)
+
+
+def event_columns(contacts: list[Contacts]) -> dict:
     c = Contacts.concatenate([c for c in contacts if len(c)])
-    events = {
+    return {
         "time": c.time,
         "kind": np.asarray([KIND[int(k)] for k in c.kind]),
         "a": c.a.astype(np.int64),
@@ -81,7 +95,6 @@ def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict]:
         "nz": c.normal[:, 2],
         "impulse": c.impulse,
     }
-    return trajectory, events
 
 
 def csv_text(columns: dict, names: list[str]) -> str:
@@ -117,14 +130,14 @@ def simulate(*args: str | Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def slopes_reference() -> tuple[dict, dict]:
+def slopes_reference() -> tuple[dict, dict, dict]:
     return reference(SLOPES, 1.5, 3)
 
 
 def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
-    trajectory, events = slopes_reference
+    trajectory, events, _ = slopes_reference
     assert set(events["kind"]) == {"sphere-plane", "sphere-sphere"}
-    common = (SLOPES, "--duration", "1.5", "--every", "3")
+    common = (SLOPES, "--duration", "1.5", "--every", "3", "--events-kind", "all")
     simulate(*common, "--out", tmp_path / "t.csv", "--events", tmp_path / "e.csv")
     simulate(*common, "--out", tmp_path / "t.npz", "--events", tmp_path / "e.npz")
     assert (tmp_path / "t.csv").read_text() == csv_text(trajectory, TRAJECTORY)
@@ -137,11 +150,11 @@ def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
 def test_many_small_chunks_give_the_same_files(tmp_path, monkeypatch, slopes_reference):
     """Chunks of 7 rows: trajectory records and step contacts are split across many chunks."""
     monkeypatch.setattr(writers, "_CHUNK_ROWS", 7)
-    trajectory, events = slopes_reference
+    trajectory, events, _ = slopes_reference
     for suffix in ("csv", "npz"):
         out, ev = tmp_path / f"t.{suffix}", tmp_path / f"e.{suffix}"
         argv = ["simulate", str(SLOPES), "--duration", "1.5", "--every", "3", "--out", str(out)]
-        assert cli.main([*argv, "--events", str(ev), "-q"]) == 0
+        assert cli.main([*argv, "--events", str(ev), "--events-kind", "all", "-q"]) == 0
     assert (tmp_path / "t.csv").read_text() == csv_text(trajectory, TRAJECTORY)
     assert (tmp_path / "e.csv").read_text() == csv_text(events, EVENTS)
     assert_npz_equals(tmp_path / "t.npz", trajectory, TRAJECTORY)
@@ -182,8 +195,32 @@ def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
     peaks = {}
     for duration in ("0.5", "2"):
         out, ev = tmp_path / f"t{duration}.{suffix}", tmp_path / f"e{duration}.{suffix}"
-        argv = ["simulate", str(scene), "--duration", duration, "--out", str(out), "--events", str(ev), "-q"]
+        argv = ["simulate", str(scene), "--duration", duration, "--out", str(out), "--events", str(ev)]
+        argv += ["--events-kind", "all", "-q"]
         peaks[duration] = peak_bytes(argv)
     assert (tmp_path / f"t2.{suffix}").stat().st_size > 50e6
     assert peaks["2"] - peaks["0.5"] < 4e6, peaks
     assert peaks["2"] < 80e6, peaks
+
+
+def test_events_default_to_impacts_the_first_step_of_each_contact(tmp_path):
+    """The slopes demo over 5 s: 1,710 contact rows, of which 47 are impacts (the bounces, the
+    two mid-air collisions, the landings); the rest are balls resting or rolling on."""
+    _, every, impacts = reference(SLOPES, 5.0, 1000)
+    simulate(SLOPES, "--duration", "5", "--events", tmp_path / "e.csv")
+    simulate(SLOPES, "--duration", "5", "--events", tmp_path / "all.npz", "--events-kind", "all")
+    assert (tmp_path / "e.csv").read_text() == csv_text(impacts, EVENTS)
+    assert_npz_equals(tmp_path / "all.npz", every, EVENTS)
+    assert len(impacts["time"]) == 47
+    assert len(every["time"]) > 30 * len(impacts["time"])
+    mid_air = impacts["kind"] == "sphere-sphere"
+    assert [(a, b) for a, b in zip(impacts["a"][mid_air], impacts["b"][mid_air], strict=True)] == [
+        (2, 3),
+        (0, 1),
+    ]
+    # each ball's last impact is on the ground, and its bounces there get weaker
+    for ball in range(5):
+        mine = (impacts["a"] == ball) & (impacts["kind"] == "sphere-plane")
+        assert impacts["b"][mine][-1] == 0
+        ground = impacts["impulse"][mine & (impacts["b"] == 0)]
+        assert len(ground) >= 3 and np.all(np.diff(ground) < 0), ground

@@ -109,6 +109,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--integrator", choices=("euler", "rk2", "rk4"), help="override the scene's integrator")
     p.add_argument("--out", type=Path, metavar="FILE", help="trajectory file, .csv or .npz")
     p.add_argument("--events", type=Path, metavar="FILE", help="contact events file, .csv or .npz")
+    p.add_argument(
+        "--events-kind",
+        choices=("impacts", "all"),
+        default="impacts",
+        help="impacts (default): a row when a contact starts (a bounce, a collision, a landing), not "
+        "for each step it rests or rolls on; all: every contact of every step",
+    )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     p.set_defaults(handler=_simulate)
@@ -211,6 +218,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 every=args.every,
                 trajectory=trajectory,
                 events=events,
+                events_kind=args.events_kind,
                 progress=not args.quiet,
             )
         except FloatingPointError as e:
@@ -230,7 +238,8 @@ def _simulate(args: argparse.Namespace) -> int:
         if trajectory is not None:
             print(f"  wrote {args.out} ({summary.records} records x {len(world.spheres)} balls)")
         if events is not None:
-            print(f"  wrote {args.events} ({events.count} contacts)")
+            what = "impacts" if args.events_kind == "impacts" else "contacts"
+            print(f"  wrote {args.events} ({events.count} {what})")
     return EXIT_OK
 
 

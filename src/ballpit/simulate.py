@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import math
 import time as clock
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from tqdm import tqdm
 
-from .physics import World
+from .physics import Contacts, World
 from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from .writers import EventWriter, TrajectoryWriter
 
@@ -77,6 +77,40 @@ def step_count(duration: float, dt: float) -> float:
     return math.ceil(duration / dt - 1e-9) if duration / dt < 2.0**62 else duration / dt
 
 
+EVENT_KINDS = ("impacts", "all")
+
+
+class ImpactFilter:
+    """Keeps, of each step's contacts, the impacts: pairs that were not in contact the step before.
+
+    A bounce, a collision, a ball landing or rolling onto another plane is the first step of a
+    contact, and is kept; the same pair resting or rolling on in the following steps is not. A
+    contact that opens and closes again (a ball bouncing, or jostled in a pile) is kept each time it
+    closes. Contacts present when the run starts count in its first step.
+    """
+
+    def __init__(self) -> None:
+        self._previous = np.zeros(0, dtype=np.int64)  # sorted pair keys of the last step
+
+    def __call__(self, contacts: Contacts) -> Contacts:
+        """The impacts among ``contacts``, the next step's contacts in order (one call per step)."""
+        keys = _pair_keys(contacts)
+        previous = self._previous
+        self._previous = np.sort(keys)
+        if len(previous) == 0 or len(keys) == 0:
+            return contacts
+        at = np.minimum(np.searchsorted(previous, keys), len(previous) - 1)
+        seen = previous[at] == keys
+        if not seen.any():
+            return contacts
+        return Contacts(**{f.name: getattr(contacts, f.name)[~seen] for f in fields(Contacts)})
+
+
+def _pair_keys(contacts: Contacts) -> np.ndarray:
+    """One integer per (kind, a, b) pair (ball and plane indices are below 2**30)."""
+    return ((contacts.a.astype(np.int64) * 2 + contacts.kind) << 32) | contacts.b.astype(np.int64)
+
+
 def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
     """Steps as (count, dt) runs that end exactly at ``duration``: whole steps, then any remainder.
 
@@ -103,13 +137,18 @@ def run(
     every: int = 1,
     trajectory: TrajectoryWriter | None = None,
     events: EventWriter | None = None,
+    events_kind: str = "impacts",
     progress: bool = False,
 ) -> RunSummary:
     """Advance ``world`` by ``duration`` seconds in steps of ``dt``, recording every ``every``-th step.
 
-    The trajectory gets the initial state, every ``every``-th step and the final state. The writers
-    are not committed here; the caller commits them on success or discards them on failure.
+    The trajectory gets the initial state, every ``every``-th step and the final state. ``events``
+    gets the impacts (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step.
+    The writers are not committed here; the caller commits them on success or discards them on failure.
     """
+    if events_kind not in EVENT_KINDS:
+        raise ValueError(f"events_kind must be one of {', '.join(EVENT_KINDS)}, got {events_kind!r}")
+    keep = ImpactFilter() if events is not None and events_kind == "impacts" else None
     scene = getattr(world, "scene", None)
     dt = dt if dt is not None else (scene.timestep if scene is not None else 1.0 / 240.0)
     plan = step_plan(duration, dt)
@@ -143,8 +182,8 @@ def run(
                 done += 1
                 if len(contacts):
                     counts += np.bincount(contacts.kind, minlength=2)[:2]
-                    if events is not None:
-                        events.add(contacts)
+                if events is not None:
+                    events.add(contacts if keep is None else keep(contacts))
                 if done % every == 0 or done == total:
                     record()
                 bar.update()  # cheap next to a step; tqdm redraws at most ~10 times a second
