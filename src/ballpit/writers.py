@@ -13,7 +13,8 @@ from __future__ import annotations
 import os
 import tempfile
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
@@ -31,6 +32,19 @@ _CHUNK_ROWS = 100_000  # rows formatted per write
 
 class OutputError(ValueError):
     """An output path that cannot be written (bad suffix, missing directory, no permission)."""
+
+
+class OutputFailed(Exception):
+    """Writing an output failed part way (a full disk, a file size limit, an I/O error)."""
+
+
+@contextmanager
+def _writing(path: Path) -> Iterator[None]:
+    """Turn an OSError while writing ``path`` into OutputFailed naming the file and the reason."""
+    try:
+        yield
+    except OSError as e:
+        raise OutputFailed(f"{shorten(path)}: cannot write: {e.strerror or e}") from e
 
 
 NAME_MAX = 255  # bytes in one file name on Linux, macOS and Windows file systems
@@ -94,8 +108,13 @@ class AtomicFile:
         os.replace(self.temp, self.target)
 
     def discard(self) -> None:
-        self.file.close()
-        self.temp.unlink(missing_ok=True)
+        """Remove the temporary file, even when closing it fails (a full disk fails the last flush)."""
+        try:
+            self.file.close()
+        except OSError:
+            pass
+        finally:
+            self.temp.unlink(missing_ok=True)
 
 
 class ColumnSpool:
@@ -108,7 +127,12 @@ class ColumnSpool:
 
     def __init__(self, names: tuple[str, ...], directory: Path) -> None:
         self.names = names
-        self.file = tempfile.TemporaryFile(dir=directory)
+        try:
+            self.file = tempfile.TemporaryFile(dir=directory)
+        except OSError as e:
+            raise OutputError(
+                f"{shorten(directory)}: cannot write a scratch file: {e.strerror or e}"
+            ) from None
         self.chunks: list[tuple[int, int]] = []  # (byte offset, rows)
         self.rows = 0
 
@@ -117,14 +141,17 @@ class ColumnSpool:
         if len(rows) == 0:
             return
         self.chunks.append((self.file.tell(), len(rows)))
-        np.ascontiguousarray(rows.T, dtype=np.float64).tofile(self.file)
+        self.file.write(np.ascontiguousarray(rows.T, dtype=np.float64).data)  # a full disk: ENOSPC
         self.rows += len(rows)
 
     def column(self, k: int):
         """Column ``k``, one chunk at a time."""
         for offset, rows in self.chunks:
             self.file.seek(offset + k * rows * 8)
-            yield np.fromfile(self.file, dtype=np.float64, count=rows)
+            chunk = np.empty(rows, dtype=np.float64)
+            if self.file.readinto(chunk.data.cast("B")) != chunk.nbytes:
+                raise OSError(f"the scratch file ended early, in column {self.names[k]!r}")
+            yield chunk
 
     def write_npz(self, out: IO[bytes], convert: dict[str, tuple[np.dtype, Callable]]) -> None:
         """Write every column to ``out`` as ``np.savez`` would (one stored ``<name>.npy`` member each).
@@ -172,13 +199,15 @@ class TrajectoryWriter:
         self.path = path
         self.format = check_output_path(path, "--out")
         self.n = n_balls
-        self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
+        self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
+        self.out = AtomicFile(
+            path, "w" if self.format == ".csv" else "wb"
+        )  # after the spool: its error leaves nothing
         self.records_per_chunk = max(1, _CHUNK_ROWS // max(1, n_balls))
         self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
         self.buffer[:, :, 1] = np.arange(n_balls)
         self.filled = 0
         self.records = 0
-        self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.row_format = ",".join(["%.9g", "%d"] + [_FLOAT] * (len(TRAJECTORY_COLUMNS) - 2)) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(TRAJECTORY_COLUMNS) + "\n")
@@ -197,23 +226,27 @@ class TrajectoryWriter:
 
     def _flush(self) -> None:
         rows = self.buffer[: self.filled].reshape(-1, len(TRAJECTORY_COLUMNS))
-        if self.spool is None:
-            self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
-        else:
-            self.spool.add(rows)
+        with _writing(self.path):
+            if self.spool is None:
+                self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
+            else:
+                self.spool.add(rows)
         self.filled = 0
 
     def commit(self) -> None:
         self._flush()
-        if self.spool is not None:
-            self.spool.write_npz(self.out.file, _TRAJECTORY_TYPES)
-            self.spool.close()
-        self.out.commit()
+        with _writing(self.path):
+            if self.spool is not None:
+                self.spool.write_npz(self.out.file, _TRAJECTORY_TYPES)
+                self.spool.close()
+            self.out.commit()
 
     def discard(self) -> None:
-        if self.spool is not None:
-            self.spool.close()
-        self.out.discard()
+        try:
+            if self.spool is not None:
+                self.spool.close()
+        finally:
+            self.out.discard()
 
 
 class EventWriter:
@@ -222,11 +255,11 @@ class EventWriter:
     def __init__(self, path: Path) -> None:
         self.path = path
         self.format = check_output_path(path, "--events")
+        self.spool = ColumnSpool(EVENT_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
         self.pending: list[Contacts] = []
         self.pending_rows = 0
         self.count = 0
-        self.spool = ColumnSpool(EVENT_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.row_format = ",".join(["%.9g", "%s", "%d", "%d"] + [_FLOAT] * 7) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(EVENT_COLUMNS) + "\n")
@@ -245,6 +278,10 @@ class EventWriter:
             return
         c = Contacts.concatenate(self.pending)
         self.pending, self.pending_rows = [], 0
+        with _writing(self.path):
+            self._write(c)
+
+    def _write(self, c: Contacts) -> None:
         if self.spool is not None:
             rows = np.empty((len(c), len(EVENT_COLUMNS)))
             rows[:, 0] = c.time
@@ -268,12 +305,15 @@ class EventWriter:
 
     def commit(self) -> None:
         self._flush()
-        if self.spool is not None:
-            self.spool.write_npz(self.out.file, _EVENT_TYPES)
-            self.spool.close()
-        self.out.commit()
+        with _writing(self.path):
+            if self.spool is not None:
+                self.spool.write_npz(self.out.file, _EVENT_TYPES)
+                self.spool.close()
+            self.out.commit()
 
     def discard(self) -> None:
-        if self.spool is not None:
-            self.spool.close()
-        self.out.discard()
+        try:
+            if self.spool is not None:
+                self.spool.close()
+        finally:
+            self.out.discard()
