@@ -348,8 +348,6 @@ def _check_render_path(out: Path, raw: str, folder: bool) -> None:
                 if not parent.is_dir():
                     raise OutputError(f"{raw}: --out: {str(parent)!r} is a file, not a folder")
                 break
-        if not folder and out.is_dir():
-            raise OutputError(f"{raw}: --out is a folder; end it with / for PNG frames")
     except OSError as e:
         raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
 

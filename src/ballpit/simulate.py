@@ -93,7 +93,7 @@ class ImpactFilter:
         self._previous = np.zeros(0, dtype=np.int64)  # sorted pair keys of the last step
 
     def __call__(self, contacts: Contacts) -> Contacts:
-        """The impacts among ``contacts``, the next step's contacts in order (one call per step)."""
+        """The impacts among one step's ``contacts``; call it once per step, in order."""
         keys = _pair_keys(contacts)
         previous = self._previous
         self._previous = np.sort(keys)
