@@ -10,9 +10,11 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from . import __version__
 
@@ -20,11 +22,61 @@ COMMANDS = ("view", "check", "simulate", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse with a one-line error message (no usage block), still exit status 2."""
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with a one-line error message (no usage block), still exit status 2.
 
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+    Subcommand parsers made by ``add_subparsers`` are of the same class. Control characters in the
+    message (an option value holding a newline or a terminal escape) are shown escaped.
+    """
+
+    def error(self, message: str) -> NoReturn:  # type: ignore[override]
+        text = one_line(message, limit=500)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {text} (see '{self.prog} --help')\n")
+
+
+def one_line(text: str, limit: int | None = None) -> str:
+    """``text`` with control characters escaped (so it stays one line), shortened to ``limit`` if given."""
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP, raised in the main thread so that every cleanup runs (like KeyboardInterrupt)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+
+
+def _on_stop_signal(signum: int, frame: object) -> None:
+    """The first stop signal unwinds the run; any later one is ignored, so the cleanup finishes."""
+    for name in _STOP_SIGNALS:
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Terminated(signum)
+
+
+def _install_stop_handlers() -> dict[int, object]:
+    """Route SIGINT, SIGTERM and SIGHUP to _on_stop_signal; returns the handlers they had."""
+    previous: dict[int, object] = {}
+    for name in _STOP_SIGNALS:
+        signum = getattr(signal, name, None)
+        if signum is None or signal.getsignal(signum) == signal.SIG_IGN:  # e.g. nohup: keep ignoring
+            continue
+        try:
+            previous[signum] = signal.signal(signum, _on_stop_signal)
+        except ValueError:  # not the main thread: leave signals alone
+            break
+    return previous
+
+
+class UsageError(ValueError):
+    """A command line whose options are each fine but that cannot be run (a run of 10¹² steps)."""
 
 
 def _positive(text: str) -> float:
@@ -62,7 +114,7 @@ def _size(text: str) -> tuple[int, int]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    parser = _Parser(
+    parser = OneLineParser(
         prog="ballpit",
         description="Balls, slopes, spin and impacts: a physics sandbox with a viewer and a headless runner.",
         epilog="With no command, or just a scene file, ballpit opens the viewer.",
@@ -93,6 +145,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--integrator", choices=("euler", "rk2", "rk4"), help="override the scene's integrator")
     p.add_argument("--out", type=Path, metavar="FILE", help="trajectory file, .csv or .npz")
     p.add_argument("--events", type=Path, metavar="FILE", help="contact events file, .csv or .npz")
+    p.add_argument(
+        "--events-kind",
+        choices=("impacts", "all"),
+        default="impacts",
+        help="impacts (default): a row when a contact starts (a bounce, a collision, a landing), not "
+        "for each step it rests or rolls on; all: every contact of every step",
+    )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     p.set_defaults(handler=_simulate)
@@ -127,16 +186,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(args_list)
     from .scene import SceneError
-    from .writers import OutputError
+    from .writers import OutputError, OutputFailed
 
+    previous = _install_stop_handlers()
     try:
         return int(args.handler(args) or EXIT_OK)
-    except (SceneError, OutputError) as e:
-        print(f"ballpit: {e}", file=sys.stderr)
+    except (SceneError, OutputError, UsageError) as e:
+        print(f"ballpit: {one_line(str(e))}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OutputFailed as e:
+        print(f"ballpit: {one_line(str(e))}; nothing was written", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print("ballpit: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated as e:
+        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _looks_like_scene(arg: str) -> bool:
@@ -161,7 +230,7 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from .simulate import format_summary, run
+    from .simulate import MAX_STEPS, format_summary, run, step_count
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
     world = _load(args.scene)
@@ -170,6 +239,12 @@ def _simulate(args: argparse.Namespace) -> int:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
     duration = args.duration or info.duration or 10.0
+    if not step_count(duration, dt) <= MAX_STEPS:
+        source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
+        raise UsageError(
+            f"{source}: {duration:g} s in steps of {dt:g} s is {step_count(duration, dt):.3g} steps; "
+            f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"
+        )
     if args.out is not None and args.events is not None and args.out.resolve() == args.events.resolve():
         raise OutputError(f"{args.out}: --out and --events must be different files")
     writers: list = []
@@ -189,6 +264,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 every=args.every,
                 trajectory=trajectory,
                 events=events,
+                events_kind=args.events_kind,
                 progress=not args.quiet,
             )
         except FloatingPointError as e:
@@ -208,7 +284,8 @@ def _simulate(args: argparse.Namespace) -> int:
         if trajectory is not None:
             print(f"  wrote {args.out} ({summary.records} records x {len(world.spheres)} balls)")
         if events is not None:
-            print(f"  wrote {args.events} ({events.count} contacts)")
+            what = "impacts" if args.events_kind == "impacts" else "contacts"
+            print(f"  wrote {args.events} ({events.count} {what})")
     return EXIT_OK
 
 
@@ -232,25 +309,82 @@ def _view(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
-    from .writers import OutputError
+    from .writers import OutputError, check_name_lengths
 
     path = resolve_scene_path(args.scene)
     world = _load(str(path))
     duration = args.duration or world.scene.duration or 10.0
     out = Path(args.out)
+    check_name_lengths(out, "--out")
     folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix
     if not folder and out.suffix.lower() not in (".gif", ".png"):
         raise OutputError(
             f"{args.out}: --out must be a .gif, a .png or a folder for frames, not {out.suffix!r}"
         )
+    _check_render_path(out, args.out, folder)
     try:
         from .viewer.render import render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
-    written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    created = _missing_folders(out if folder else out.parent)
+    before = _render_files(out, folder)
+    try:
+        written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    except BaseException:  # interrupted, stopped or failed: no frames or half-written file from this run
+        _remove_render_output(out, folder, before, created)
+        raise
     print(f"wrote {written or out}")
     return EXIT_OK
+
+
+def _check_render_path(out: Path, raw: str, folder: bool) -> None:
+    """OutputError unless ``out`` can be made: every existing part of its path up to it a folder."""
+    from .writers import OutputError
+
+    try:
+        for parent in (out, *out.parents) if folder else out.parents:
+            if parent.exists():
+                if not parent.is_dir():
+                    raise OutputError(f"{raw}: --out: {str(parent)!r} is a file, not a folder")
+                break
+    except OSError as e:
+        raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """The folders on the way to ``folder`` that do not exist yet, deepest first."""
+    return [p for p in (folder, *folder.parents) if not p.exists()]
+
+
+def _render_files(out: Path, folder: bool) -> dict[Path, tuple[int, int]]:
+    """The files a render to ``out`` writes that exist now, with their (mtime, inode)."""
+    files = sorted(out.glob("frame_*.png")) if folder and out.is_dir() else [out]
+    found = {}
+    for file in files:
+        try:
+            st = file.stat()
+        except OSError:
+            continue
+        found[file] = (st.st_mtime_ns, st.st_ino)
+    return found
+
+
+def _remove_render_output(
+    out: Path, folder: bool, before: dict[Path, tuple[int, int]], created: list[Path]
+) -> None:
+    """Remove what a stopped render wrote (files new or changed since ``before``) and the folders it made."""
+    for file, stamp in _render_files(out, folder).items():
+        if before.get(file) != stamp:
+            try:
+                file.unlink()
+            except OSError:
+                pass
+    for made in created:  # deepest first; only if empty
+        try:
+            made.rmdir()
+        except OSError:
+            break
 
 
 def _bench(argv: list[str]) -> int:
