@@ -243,3 +243,20 @@ def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
         assert len(lines) == 1, proc.stderr
         assert "no display" in lines[0] and "ballpit render SCENE --out demo.gif" in lines[0]
         assert "xvfb-run ballpit" in lines[0]
+
+
+def test_f2_shows_the_time_of_each_stage_of_the_step_and_f2_again_goes_back(xvfb, tmp_path):
+    from ballpit.physics.profile import STAGES
+
+    result = run_scenario(xvfb, "profile_page", tmp_path)
+    text = result["profile"]
+    ms = {}
+    for line in text.splitlines():
+        match = re.fullmatch(r"(.+?)\s+(\d+\.\d+) ms", line)
+        if match:
+            ms[match.group(1).strip()] = float(match.group(2))
+    assert set(STAGES) <= set(ms), text
+    assert ms["step"] > 0 and sum(ms[s] for s in STAGES) <= ms["step"] * 1.01 + 0.002, text
+    steps = int(re.search(r"step profile, (\d+) steps", text).group(1))
+    assert steps > 0 and re.search(r"intervals/step \d+\.\d+", text)
+    assert result["page"] == "stats" and "sim time" in result["back"]

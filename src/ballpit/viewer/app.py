@@ -144,6 +144,9 @@ class Viewer:
             self.flags.trails = not self.flags.trails
         elif action is Action.HUD:
             self.hud.show_hud = not self.hud.show_hud
+        elif action is Action.PROFILE:
+            self.hud.page = "stats" if self.hud.page == "profile" else "profile"
+            self.hud.show_hud = True
         elif action is Action.HELP:
             self.hud.show_help = not self.hud.show_help
         elif action is Action.SCREENSHOT:
@@ -266,11 +269,14 @@ class Viewer:
                                               ("trails", f.trails)) if on)  # fmt: skip
 
     def _draw_hud(self, now: float) -> None:
-        from .hud import hud_lines
+        from .hud import hud_lines, profile_lines
 
         if now >= self._hud_at:
             self._hud_at = now + HUD_INTERVAL
-            self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names()))
+            if self.hud.page == "profile":
+                self.hud.set_text(profile_lines(self.sim))
+            else:
+                self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names()))
             self.hud.set_error(self.sim.error)
         if self.sim.message != self._shown_message:
             self._shown_message = self.sim.message

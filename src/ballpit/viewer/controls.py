@@ -35,6 +35,7 @@ class Action(Enum):
     VELOCITIES = "show velocity arrows"
     TRAILS = "show trails"
     HUD = "show / hide the HUD"
+    PROFILE = "HUD page: where the step's time goes"
     HELP = "show / hide this help"
     SCREENSHOT = "save a screenshot PNG"
 
@@ -59,6 +60,7 @@ KEY_ACTIONS: dict[str, Action] = {
     "T": Action.TRAILS,
     "H": Action.HUD,
     "F1": Action.HELP,
+    "F2": Action.PROFILE,
     "F12": Action.SCREENSHOT,
 }
 
@@ -112,6 +114,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("Esc", "release the mouse; Esc twice quits"),
     ("C / V / T", "contacts and normals / velocity arrows / trails"),
     ("H / F1", "HUD / this help"),
+    ("F2", "HUD page: time per stage of the step"),
     ("F12", "screenshot PNG into screenshots/"),
 )
 

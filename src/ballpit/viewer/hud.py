@@ -40,7 +40,21 @@ def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
         f"fly speed   {fly_speed:9.2f} m/s",
         f"overlays    {overlays or 'none'} (C V T)",
         f"state       {state}",
-        "F1 help  H hide",
+        "F1 help  F2 profile  H hide",
+    ]
+
+
+def profile_lines(sim: Simulation) -> list[str]:
+    """The HUD's profile page: where the step's time went over the last second, stage by stage
+    (``World.profile``, like Box2D's b2Profile), with intervals, pairs and contacts per step."""
+    p = sim.profile
+    if not p.steps:
+        return [f"{sim.appearance.name}: step profile", "no steps yet (X drops)", "F2 back  H hide"]
+    return [
+        f"{sim.appearance.name}: step profile, {p.steps} steps",
+        f"{'stage':<15}{'per step':>12}",
+        *p.lines(),
+        "F2 back  H hide",
     ]
 
 
@@ -58,6 +72,7 @@ class Hud:
         self.batch = pyglet.graphics.Batch()
         self.help_batch = pyglet.graphics.Batch()
         self.show_hud = True
+        self.page = "stats"  # or "profile" (F2)
         self.show_help = False
         self.text = ""
         self.error = ""

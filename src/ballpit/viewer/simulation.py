@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ballpit.physics.profile import RunProfile
+
 from .appearance import Appearance, appearance_of
 
 MAX_FRAME_SECONDS = 0.25
@@ -106,9 +108,6 @@ class Simulation:
         self.path = self.appearance.path
         self.initial = copy.deepcopy(world)
         self._signature = _file_signature(self.path)
-        spheres = world.spheres
-        self.masses = np.array(spheres.masses, dtype=float)
-        self.inertias = np.array([s.inertia for s in spheres], dtype=float)  # once per world, not per frame
         self._reset_dynamics()
         self.generation += 1
 
@@ -129,6 +128,8 @@ class Simulation:
         self._stats_wall = 0.0
         self._stats_steps = 0
         self._stats_sim = 0.0
+        self.profile = RunProfile()  # the steps of the last stats window, stage by stage
+        self._profile = RunProfile()
 
     @property
     def timestep(self) -> float:
@@ -261,6 +262,7 @@ class Simulation:
             print(f"ballpit: {self.error}", file=sys.stderr, flush=True)
             return
         contacts.append(result)
+        self._profile.add(self.world.profile)
         self.last_step_contacts = len(result)
         self.steps_total += 1
         self._stats_steps += 1
@@ -281,6 +283,8 @@ class Simulation:
             self._stats_wall = 0.0
             self._stats_steps = 0
             self._stats_sim = 0.0
+            if self._profile.steps:  # paused: keep showing the last window that stepped
+                self.profile, self._profile = self._profile, RunProfile()
 
     # ------------------------------------------------------------------ what to draw
     def render_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -300,10 +304,5 @@ class Simulation:
         return positions, q
 
     def kinetic_energy(self) -> float:
-        """Translational plus rotational kinetic energy of all balls, J."""
-        spheres = self.world.spheres
-        v = np.asarray(spheres.velocities)
-        w = np.asarray(spheres.angular_velocities)
-        return 0.5 * float(
-            self.masses @ np.einsum("ij,ij->i", v, v) + self.inertias @ np.einsum("ij,ij->i", w, w)
-        )
+        """Translational plus rotational kinetic energy of all balls, J (the physics' own measure)."""
+        return self.world.kinetic_energy()
