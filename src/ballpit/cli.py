@@ -144,14 +144,14 @@ def _looks_like_scene(arg: str) -> bool:
 
 
 def _load(scene_arg: str):
-    from .scene import load_scene, resolve_scene_path
+    from .scene import read_scene, resolve_scene_path
 
-    return load_scene(resolve_scene_path(scene_arg))
+    return read_scene(resolve_scene_path(scene_arg))
 
 
 def _check(args: argparse.Namespace) -> int:
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     duration = f", suggested duration {info.duration:g} s" if info.duration else ""
     print(
         f"{info.path}: ok: {len(world.spheres)} balls, {len(world.planes)} planes, {world.integrator}, "
@@ -164,8 +164,8 @@ def _simulate(args: argparse.Namespace) -> int:
     from .simulate import format_summary, run
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     if args.integrator:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
@@ -190,6 +190,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 trajectory=trajectory,
                 events=events,
                 progress=not args.quiet,
+                name=info.name,
             )
         except FloatingPointError as e:
             print(
@@ -235,8 +236,7 @@ def _render(args: argparse.Namespace) -> int:
     from .writers import OutputError
 
     path = resolve_scene_path(args.scene)
-    world = _load(str(path))
-    duration = args.duration or world.scene.duration or 10.0
+    duration = args.duration or _load(str(path)).duration or 10.0
     out = Path(args.out)
     folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix
     if not folder and out.suffix.lower() not in (".gif", ".png"):

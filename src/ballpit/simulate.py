@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from tqdm import tqdm
 
-from .physics import World
+from .physics import DEFAULT_TIMESTEP, World
 from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from .writers import EventWriter, TrajectoryWriter
 
@@ -92,14 +92,15 @@ def run(
     trajectory: TrajectoryWriter | None = None,
     events: EventWriter | None = None,
     progress: bool = False,
+    name: str = "simulate",
 ) -> RunSummary:
     """Advance ``world`` by ``duration`` seconds in steps of ``dt``, recording every ``every``-th step.
 
-    The trajectory gets the initial state, every ``every``-th step and the final state. The writers
-    are not committed here; the caller commits them on success or discards them on failure.
+    ``dt`` defaults to the physics' default timestep; ``name`` labels the progress bar. The trajectory
+    gets the initial state, every ``every``-th step and the final state. The writers are not committed
+    here; the caller commits them on success or discards them on failure.
     """
-    scene = getattr(world, "scene", None)
-    dt = dt if dt is not None else (scene.timestep if scene is not None else 1.0 / 240.0)
+    dt = dt if dt is not None else DEFAULT_TIMESTEP
     plan = step_plan(duration, dt)
     total = sum(n for n, _ in plan)
     balls = world.spheres
@@ -122,7 +123,7 @@ def run(
         delay=1.0,
         leave=False,
         dynamic_ncols=True,
-        desc=getattr(scene, "name", "simulate"),
+        desc=name,
     )
     began = clock.perf_counter()
     try:

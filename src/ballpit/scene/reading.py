@@ -1,0 +1,201 @@
+"""Reading a scene file: bytes -> text -> TOML tables, with one-line errors.
+
+``tomllib`` reports line numbers only for syntax errors, so ``LineIndex`` scans the raw text for the
+table headers and keys itself; the field readers use it to say which line a bad value is on.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+
+class SceneError(ValueError):
+    """A problem with a scene file, as one line naming the file, line, entry, key and value."""
+
+    def __init__(
+        self,
+        path: Path | str,
+        problem: str,
+        *,
+        line: int | None = None,
+        entry: str | None = None,
+        key: str | None = None,
+    ) -> None:
+        self.path = Path(path)
+        self.line = line
+        self.entry = entry
+        self.key = key
+        self.problem = problem
+        where = f"{path}:{line}" if line is not None else f"{path}"
+        parts = [where]
+        if entry:
+            parts.append(entry)
+        if key:
+            parts.append(f"key '{key}'")
+        parts.append(problem)
+        super().__init__(": ".join(parts))
+
+
+def read_toml(path: Path) -> tuple[str, dict]:
+    """The file's text and its parsed tables; ``SceneError`` if it cannot be read or parsed."""
+    text = read_text(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise syntax_error(path, text, e) from None
+    return text, data
+
+
+def read_text(path: Path) -> str:
+    """The file as UTF-8 text; ``SceneError`` naming the reason when it cannot be read."""
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise SceneError(path, "no such file") from None
+    except IsADirectoryError:
+        raise SceneError(path, "is a directory, not a scene file") from None
+    except PermissionError:
+        raise SceneError(path, "permission denied") from None
+    except OSError as e:
+        raise SceneError(path, f"cannot read: {e.strerror or e}") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise SceneError(path, "not UTF-8 text; is this a scene file?", line=line) from None
+
+
+_AT_LINE = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+_AT_END = re.compile(r"\s*\(at end of document\)\s*$")
+
+
+def syntax_error(path: Path, text: str, e: tomllib.TOMLDecodeError) -> SceneError:
+    """A TOML syntax error as a ``SceneError`` on the line where the parser stopped."""
+    msg = str(e)
+    m = _AT_LINE.search(msg)
+    if m:
+        problem = f"TOML syntax error: {msg[: m.start()]} (column {m.group(2)})"
+        return SceneError(path, problem, line=int(m.group(1)))
+    m = _AT_END.search(msg)
+    if m:
+        # Something left open (an array, a string): point at the last line that has anything on it.
+        lines = text.splitlines()
+        last = max((i + 1 for i, ln in enumerate(lines) if ln.strip()), default=None)
+        return SceneError(path, f"TOML syntax error: {msg[: m.start()]} at the end of the file", line=last)
+    return SceneError(path, f"TOML syntax error: {msg}")
+
+
+# ---------------------------------------------------------------------------------------- line index
+
+
+@dataclass
+class Table:
+    """Where one table of the file is: its header line and the line of each of its keys."""
+
+    header_line: int | None
+    key_lines: dict[str, int]
+
+
+_HEADER = re.compile(r"^\s*(\[\[|\[)\s*([^\[\]#]+?)\s*(\]\]|\])\s*(?:#.*)?$")
+_KEY = re.compile(r"""^\s*("(?:[^"\\]|\\.)*"|'[^']*'|[A-Za-z0-9_-]+)\s*[.=]""")
+
+
+def _unquote(name: str) -> str:
+    parts = [p.strip() for p in re.split(r"\.(?=(?:[^\"']|\"[^\"]*\"|'[^']*')*$)", name)]
+    return ".".join(p[1:-1] if len(p) >= 2 and p[0] == p[-1] and p[0] in "\"'" else p for p in parts)
+
+
+class LineIndex:
+    """Header and key line numbers, found by scanning the raw TOML text.
+
+    Lines inside multi-line strings and multi-line arrays are skipped, so a value that happens to look
+    like ``[x]`` or ``key =`` is not mistaken for a header or a key.
+    """
+
+    def __init__(self, text: str) -> None:
+        self.root = Table(None, {})
+        self.tables: dict[str, Table] = {}
+        self.arrays: dict[str, list[Table]] = {}
+        current = self.root
+        depth = 0  # open brackets/braces of a value continuing onto later lines
+        multiline: str | None = None  # the closing delimiter of an open multi-line string
+        for number, line in enumerate(text.splitlines(), start=1):
+            if multiline is None and depth == 0:
+                header = _HEADER.match(line)
+                if header:
+                    name = _unquote(header.group(2))
+                    current = Table(number, {})
+                    if header.group(1) == "[[":
+                        self.arrays.setdefault(name, []).append(current)
+                    else:
+                        self.tables.setdefault(name, current)
+                    continue
+                key = _KEY.match(line)
+                if key:
+                    current.key_lines.setdefault(_unquote(key.group(1)), number)
+            depth, multiline = _scan_line(line, depth, multiline)
+
+    def table(self, name: str) -> Table | None:
+        """Where ``[name]`` is, if the file has it."""
+        return self.tables.get(name)
+
+    def array_item(self, name: str, index: int) -> Table | None:
+        """Where the ``index``-th (from 0) ``[[name]]`` is, if the file has it."""
+        items = self.arrays.get(name, [])
+        return items[index] if index < len(items) else None
+
+
+def _scan_line(line: str, depth: int, multiline: str | None) -> tuple[int, str | None]:
+    """Bracket depth and open multi-line string after one line of TOML."""
+    i, n = 0, len(line)
+    while i < n:
+        if multiline is not None:
+            end = _find_closing(line, i, multiline)
+            if end < 0:
+                return depth, multiline
+            i, multiline = end + 3, None
+            continue
+        c = line[i]
+        if c == "#":
+            break
+        if c in "\"'":
+            if line.startswith(c * 3, i):
+                multiline = c * 3
+                i += 3
+                continue
+            i = _skip_string(line, i + 1, c)
+            continue
+        if c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth = max(0, depth - 1)
+        i += 1
+    return depth, multiline
+
+
+def _find_closing(line: str, start: int, delim: str) -> int:
+    i = start
+    while True:
+        j = line.find(delim, i)
+        if j < 0:
+            return -1
+        if delim == '"""':
+            backslashes = len(line[:j]) - len(line[:j].rstrip("\\"))
+            if backslashes % 2:
+                i = j + 1
+                continue
+        return j
+
+
+def _skip_string(line: str, i: int, quote: str) -> int:
+    while i < len(line):
+        if quote == '"' and line[i] == "\\":
+            i += 2
+            continue
+        if line[i] == quote:
+            return i + 1
+        i += 1
+    return i
