@@ -123,15 +123,23 @@ class Builder:
             raise SceneError(self.path, f"unknown table or key '{key}'{hint}", line=line)
 
     def table(self, name: str) -> Entry:
+        """The ``[name]`` table (empty when the file has none)."""
         value = self.data.get(name, {})
-        if not isinstance(value, dict):
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
             first = self.lines.array_item(name, 0)
             line = first.header_line if first else None
             raise SceneError(self.path, f"write [{name}] once, as a table, not [[{name}]]", line=line)
+        if not isinstance(value, dict):
+            problem = f"'{name}' must be a table written [{name}], got {show(value)}"
+            raise SceneError(self.path, problem, line=self.lines.root.key_lines.get(name))
         return Entry(self.path, f"[{name}]", value, self.lines.table(name))
 
     def array(self, name: str) -> list[Entry]:
+        """The ``[[name]]`` tables, in file order."""
         value = self.data.get(name, [])
+        if not isinstance(value, dict | list):
+            problem = f"'{name}' must be tables written [[{name}]], got {show(value)}"
+            raise SceneError(self.path, problem, line=self.lines.root.key_lines.get(name))
         if isinstance(value, dict):
             where = self.lines.table(name)
             raise SceneError(

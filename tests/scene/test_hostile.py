@@ -1,0 +1,82 @@
+"""Hostile scene files: each gives one line naming the file and the problem, exit status 2, and no
+traceback, from both ``ballpit check`` and ``ballpit simulate``; none hangs or runs away."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+import warnings
+from contextlib import redirect_stderr, redirect_stdout
+from pathlib import Path
+
+import pytest
+
+from ballpit import cli
+
+
+def run_cli(*args: str | Path) -> tuple[int, list[str]]:
+    """Run the command line in this process: (exit status, stderr lines and any warnings)."""
+    err, out = io.StringIO(), io.StringIO()
+    with redirect_stderr(err), redirect_stdout(out), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            code = cli.main([str(a) for a in args])
+        except SystemExit as e:  # argparse
+            code = e.code
+    return code, err.getvalue().splitlines() + [f"warning: {w.message}" for w in caught]
+
+
+def refused(path: Path, *fragments: str) -> str:
+    """Assert that check and simulate both refuse ``path`` with one line; returns that line."""
+    lines_seen = []
+    for command in (["check", path], ["simulate", path, "--duration", "0.01", "--quiet"]):
+        code, lines = run_cli(*command)
+        assert code == 2 and len(lines) == 1, (command[0], code, lines[:5])
+        line = lines[0]
+        assert line.startswith(f"ballpit: {path}"), line
+        for fragment in fragments:
+            assert fragment in line, line
+        lines_seen.append(line)
+    assert lines_seen[0] == lines_seen[1]
+    return lines_seen[0]
+
+
+def scene(tmp_path: Path, text: str, name: str = "hostile.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# ---------------------------------------------------------------------------------------- structure
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("sphere = 5\n", "'sphere' must be tables written [[sphere]], got 5"),
+        ('grid = "x"\n', "'grid' must be tables written [[grid]]"),
+        ("world = 5\n", "'world' must be a table written [world], got 5"),
+        ("camera = [1, 2]\n", "'camera' must be a table written [camera], got [1, 2]"),
+    ],
+)
+def test_a_top_level_value_where_a_table_belongs(tmp_path, text, fragment):
+    line = refused(scene(tmp_path, text), fragment)
+    assert ":1:" in line
+
+
+def test_ten_thousand_nested_brackets(tmp_path):
+    refused(scene(tmp_path, "a = " + "[" * 10_000 + "]" * 10_000 + "\n"), "nested too deeply")
+
+
+def test_nested_inline_tables(tmp_path):
+    refused(scene(tmp_path, "a = " + "{b = " * 5_000 + "1" + "}" * 5_000 + "\n"), "nested too deeply")
+
+
+def test_a_subprocess_gives_the_same_single_line(tmp_path):
+    path = scene(tmp_path, "sphere = 5\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "ballpit", "check", str(path)], capture_output=True, text=True, timeout=120
+    )
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.splitlines() == [f"ballpit: {path}:1: 'sphere' must be tables written [[sphere]], got 5"]
