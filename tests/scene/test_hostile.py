@@ -73,6 +73,12 @@ def test_nested_inline_tables(tmp_path):
     refused(scene(tmp_path, "a = " + "{b = " * 5_000 + "1" + "}" * 5_000 + "\n"), "nested too deeply")
 
 
+def test_a_deep_list_that_parses_is_shown_shortened(tmp_path):
+    text = "[[sphere]]\nposition = " + "[" * 300 + "1" + "]" * 300 + "\n"
+    line = refused(scene(tmp_path, text), "key 'position': must be a list of 3 numbers, got [[[")
+    assert "[…]" in line
+
+
 def test_a_subprocess_gives_the_same_single_line(tmp_path):
     path = scene(tmp_path, "sphere = 5\n")
     r = subprocess.run(

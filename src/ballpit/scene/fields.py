@@ -18,8 +18,10 @@ from .colours import hex_to_rgb
 from .reading import SceneError, Table
 
 
-def show(value: object) -> str:
-    """A value as it would be written in TOML, for error messages."""
+def show(value: object, depth: int = 0) -> str:
+    """A value as it would be written in TOML, for error messages (nesting past 8 levels as ``[…]``)."""
+    if depth > 8 and isinstance(value, list | dict):
+        return "[…]" if isinstance(value, list) else "{…}"
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
@@ -31,9 +33,9 @@ def show(value: object) -> str:
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, list):
-        return "[" + ", ".join(show(v) for v in value) + "]"
+        return "[" + ", ".join(show(v, depth + 1) for v in value) + "]"
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {show(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{k} = {show(v, depth + 1)}" for k, v in value.items()) + "}"
     return str(value)
 
 

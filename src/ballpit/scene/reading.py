@@ -46,6 +46,8 @@ def read_toml(path: Path) -> tuple[str, dict]:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise syntax_error(path, text, e) from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise SceneError(path, "values are nested too deeply (arrays or inline tables)") from None
     return text, data
 
 
