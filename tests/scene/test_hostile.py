@@ -86,3 +86,50 @@ def test_a_subprocess_gives_the_same_single_line(tmp_path):
     )
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.splitlines() == [f"ballpit: {path}:1: 'sphere' must be tables written [[sphere]], got 5"]
+
+
+# ---------------------------------------------------------------------------------------- numbers
+
+GRID = "[[grid]]\ncorner = [0, 1, 0]\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        (GRID + "count = [1, 1, 1]\njitter = 1e308\n", "key 'jitter': must be between 0 and 1e9, got 1e+308"),
+        (GRID + "count = [2, 2, 2]\njitter = 1e308\n", "key 'jitter': must be between 0 and 1e9"),
+        (GRID + "count = [2, 1, 1]\nvelocity_jitter = 1e308\n", "key 'velocity_jitter': must be between 0"),
+        (GRID + "count = [3, 1, 1]\nspacing = 1e308\n", "key 'spacing': must be between 1e-9 and 1e9"),
+        (GRID + "count = [3, 1, 1]\nspacing = 1e300\n", "key 'spacing': must be between 1e-9 and 1e9"),
+        (
+            "[[sphere]]\nposition = [0, 1, 0]\norientation = [1e308, 1e308, 1e308, 1e308]\n",
+            "key 'orientation': components must be between -1e9 and 1e9",
+        ),
+        ("[[sphere]]\nposition = [0, 1, 0]\nradius = 1e308\n", "key 'radius': must be between 1e-9 and 1e9"),
+        ("[[sphere]]\nposition = [0, 1, 0]\nradius = 1e-300\n", "key 'radius': must be between 1e-9 and 1e9"),
+        ("[[sphere]]\nposition = [0, 1, 0]\nmass = 1e-320\n", "key 'mass': must be between 1e-9 and 1e9"),
+        ("[[plane]]\nnormal = [1e308, 1e308, 0]\n", "key 'normal': components must be between -1e9 and 1e9"),
+        ("[world]\ngravity = [0, -1e300, 0]\n", "key 'gravity': components must be between"),
+        ("[world]\ntimestep = 1e-300\n", "key 'timestep': must be between 1e-9 and 1e9"),
+        ("[[plane]]\nsize = [1e-300, 1]\n", "key 'size': must be between 1e-9 and 1e9"),
+        ("[camera]\nposition = [1e300, 0, 0]\n", "key 'position': components must be between"),
+    ],
+)
+def test_numbers_that_cannot_be_computed_with_are_refused(tmp_path, text, fragment):
+    refused(scene(tmp_path, text), fragment)
+
+
+def test_a_grid_reaching_beyond_the_largest_coordinate_is_refused(tmp_path):
+    text = "[[grid]]\ncenter = [0, 1, 0]\ncount = [1000, 1, 1]\nspacing = 1e7\nradius = 1\n"
+    refused(scene(tmp_path, text), "grid #1", "key 'spacing'", "reaches 4.995e+09 m from the origin")
+
+
+def test_the_largest_and_smallest_numbers_still_load(tmp_path):
+    text = (
+        "[world]\ngravity = [0, -1e9, 0]\ntimestep = 1e-9\n"
+        "[[plane]]\nposition = [0, -1e9, 0]\nsize = 1e9\n"
+        "[[sphere]]\nposition = [0, 1, 0]\nradius = 1e-9\nmass = 1e-9\nvelocity = [1e9, 0, 0]\n"
+        "[[sphere]]\nposition = [1e9, 1e9, 0]\nradius = 1e9\nmass = 1e9\n"
+    )
+    code, lines = run_cli("check", scene(tmp_path, text))
+    assert code == 0 and lines == []

@@ -15,7 +15,7 @@ from ..physics import World
 from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls
-from .fields import Entry, did_you_mean, show
+from .fields import LARGEST, Entry, did_you_mean, show
 from .reading import LineIndex, SceneError
 
 
@@ -248,6 +248,10 @@ class Builder:
                 f"neighbouring balls would overlap: spacing {spacing[axis]:g} along {'xyz'[axis]} "
                 f"is less than {why} = {need:g}",
             )
+        far = layout.reach(count, spacing, corner, center) + jitter
+        if far > LARGEST:
+            key = "spacing" if "spacing" in e.data else "count"
+            raise e.error(key, f"the block reaches {far:.4g} m from the origin, beyond 1e9 m")
         positions = layout.grid_positions(count, spacing, corner, center)
         positions, props["velocity"] = layout.jitter(
             positions, props["velocity"], jitter, velocity_jitter, seed

@@ -51,6 +51,11 @@ def did_you_mean(word: str, options: Iterable[str]) -> str:
 
 
 _COLOR_SHAPE = 'must be "#rrggbb" or [r, g, b] with components 0..1'
+# The range of every number a scene file gives (lengths in m, masses in kg, speeds in m/s, ...), and
+# the least a size, mass or time may be. Within it, whatever the physics forms from the numbers (m·r²,
+# 1/(m·r²), m·v², a position over a ball's size) stays finite and well away from overflow.
+LARGEST = 1e9
+SMALLEST = 1e-9
 
 
 class Entry:
@@ -108,6 +113,10 @@ class Entry:
             raise self.error(key, "must be positive", value)
         if nonnegative and x < 0:
             raise self.error(key, "must not be negative", value)
+        if positive and not SMALLEST <= x <= LARGEST:
+            raise self.error(key, "must be between 1e-9 and 1e9", value)
+        if abs(x) > LARGEST:
+            raise self.error(key, f"must be between {'0' if nonnegative else '-1e9'} and 1e9", value)
         return x
 
     def integer(self, key: str, default: int, *, minimum: int = 0) -> int:
@@ -140,6 +149,8 @@ class Entry:
         arr = np.array(value, dtype=float)
         if not np.isfinite(arr).all():
             raise self.error(key, "must be finite", value)
+        if (np.abs(arr) > LARGEST).any():
+            raise self.error(key, "components must be between -1e9 and 1e9", value)
         return arr
 
     def nonzero_vector(self, key: str, length: int = 3) -> np.ndarray | None:
@@ -163,6 +174,8 @@ class Entry:
             raise self.error(key, "must be finite", value)
         if (arr <= 0).any():
             raise self.error(key, "must be positive", value)
+        if ((arr < SMALLEST) | (arr > LARGEST)).any():
+            raise self.error(key, "must be between 1e-9 and 1e9", value)
         return np.broadcast_to(arr, (count,)).copy()
 
     def choice(self, key: str, default: str, options: tuple[str, ...]) -> str:

@@ -19,6 +19,18 @@ def grid_positions(
     return corner + offsets
 
 
+def reach(
+    count: tuple[int, int, int],
+    spacing: np.ndarray,
+    corner: np.ndarray | None = None,
+    center: np.ndarray | None = None,
+) -> float:
+    """How far from the origin (largest coordinate) the block's centres go, before any jitter."""
+    extent = (np.array(count) - 1) * spacing
+    first = center - 0.5 * extent if center is not None else corner
+    return float(np.maximum(np.abs(first), np.abs(first + extent)).max())
+
+
 def jitter(
     positions: np.ndarray, velocity: np.ndarray, amount: float, velocity_amount: float, seed: int
 ) -> tuple[np.ndarray, np.ndarray]:
