@@ -4,6 +4,7 @@ traceback, from both ``ballpit check`` and ``ballpit simulate``; none hangs or r
 from __future__ import annotations
 
 import io
+import os
 import subprocess
 import sys
 import warnings
@@ -133,3 +134,36 @@ def test_the_largest_and_smallest_numbers_still_load(tmp_path):
     )
     code, lines = run_cli("check", scene(tmp_path, text))
     assert code == 0 and lines == []
+
+
+# ---------------------------------------------------------------------------------------- files
+
+
+def test_a_file_name_over_255_bytes(tmp_path):
+    refused(tmp_path / ("x" * 300 + ".toml"), "File name too long")
+
+
+def test_a_fifo_is_refused_without_blocking(tmp_path):
+    fifo = tmp_path / "pipe.toml"
+    os.mkfifo(fifo)
+    for command in ("check", "simulate"):
+        r = subprocess.run(
+            [sys.executable, "-m", "ballpit", command, str(fifo)], capture_output=True, text=True, timeout=60
+        )
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.splitlines() == [f"ballpit: {fifo}: not a regular file (a pipe, device or socket)"]
+
+
+def test_dev_zero_is_refused_without_reading_it():
+    r = subprocess.run(
+        [sys.executable, "-m", "ballpit", "check", "/dev/zero"], capture_output=True, text=True, timeout=60
+    )
+    assert r.returncode == 2
+    assert r.stderr.splitlines() == ["ballpit: /dev/zero: not a regular file (a pipe, device or socket)"]
+
+
+def test_a_file_over_16_mib_is_refused_unread(tmp_path):
+    path = tmp_path / "huge.toml"
+    with open(path, "wb") as f:
+        f.truncate(16 * 1024 * 1024 + 1)  # sparse: costs no disk
+    refused(path, "16777217 bytes, more than a scene file may have (16 MiB)")

@@ -55,7 +55,10 @@ def resolve_scene_path(name: str | Path) -> Path:
     An unknown name comes back unchanged, so loading it reports the missing file.
     """
     path = Path(name)
-    if path.exists():
+    try:
+        if path.exists():
+            return path
+    except OSError:  # e.g. a name too long for the file system: reading it will say so
         return path
     stem = path.name.removesuffix(".toml")
     if path.parent == Path(".") and stem:
