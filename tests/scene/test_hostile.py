@@ -167,3 +167,24 @@ def test_a_file_over_16_mib_is_refused_unread(tmp_path):
     with open(path, "wb") as f:
         f.truncate(16 * 1024 * 1024 + 1)  # sparse: costs no disk
     refused(path, "16777217 bytes, more than a scene file may have (16 MiB)")
+
+
+# ---------------------------------------------------------------------------------------- size
+
+
+def test_the_total_number_of_balls_is_capped_not_each_grid(tmp_path):
+    grids = "".join(
+        f"[[grid]]\ncorner = [{k * 1000}, 1, 0]\ncount = [100, 100, 60]\nradius = 0.1\n" for k in range(10)
+    )
+    line = refused(scene(tmp_path, grids), "grid #2", "key 'count'")
+    assert (
+        "asks for 600,000 balls; with the 600,000 before it that is more than the 1,000,000 a scene may have"
+        in line
+    )
+
+
+def test_one_grid_over_the_cap(tmp_path):
+    text = "[[grid]]\ncorner = [0, 1, 0]\ncount = [200, 100, 100]\n"
+    refused(
+        scene(tmp_path, text), "grid #1", "asks for 2,000,000 balls, more than the 1,000,000 a scene may have"
+    )

@@ -201,6 +201,8 @@ class Builder:
 
     def sphere(self, e: Entry, balls: Balls) -> None:
         e.check_keys(schema.SPHERE_KEYS)
+        if balls.count >= schema.MAX_BALLS:
+            raise e.error(None, f"one ball more than the {schema.MAX_BALLS:,} a scene may have")
         e.require("position")
         position = e.vector("position", None)
         props = self.ball_properties(e)
@@ -221,8 +223,10 @@ class Builder:
         if min(count) < 1:
             raise e.error("count", "every count must be at least 1", count)
         n = count[0] * count[1] * count[2]
-        if n > schema.MAX_GRID_BALLS:
-            raise e.error("count", f"asks for more than {schema.MAX_GRID_BALLS:,} balls", count)
+        cap = schema.MAX_BALLS
+        if n > cap - balls.count:
+            before = f"; with the {balls.count:,} before it that is" if balls.count else ","
+            raise e.error("count", f"asks for {n:,} balls{before} more than the {cap:,} a scene may have")
         count = tuple(count)
         corner = e.vector("corner", None)
         center = e.vector("center", None)

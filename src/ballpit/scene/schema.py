@@ -52,7 +52,7 @@ GRID_SPACING = 2.2  # default spacing between ball centres, in radii
 GRID_JITTER = 0.0  # m, the largest random offset of each ball along each axis
 GRID_VELOCITY_JITTER = 0.0  # m/s, the same for each ball's velocity
 GRID_SEED = 0
-MAX_GRID_BALLS = 2_000_000
+MAX_BALLS = 1_000_000  # in the whole scene, spheres and grids together
 
 # Balls or a ball and a plane may touch at the start (a cradle, a ball resting on the floor), but not
 # interpenetrate by more than this.
