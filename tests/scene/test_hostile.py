@@ -7,13 +7,16 @@ import io
 import os
 import subprocess
 import sys
+import time
 import warnings
 from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ballpit import cli
+from ballpit.scene import read_scene
 
 
 def run_cli(*args: str | Path) -> tuple[int, list[str]]:
@@ -188,3 +191,13 @@ def test_one_grid_over_the_cap(tmp_path):
     refused(
         scene(tmp_path, text), "grid #1", "asks for 2,000,000 balls, more than the 1,000,000 a scene may have"
     )
+
+
+def test_forty_thousand_sphere_tables_check_in_linear_time(tmp_path):
+    # Re-adding every earlier block for each new sphere made this take 37 s; linear it takes a few.
+    text = "".join(f"[[sphere]]\nposition = [{2 * k}, 1, 0]\n" for k in range(40_000))
+    started = time.perf_counter()
+    scene_ = read_scene(scene(tmp_path, text))
+    assert time.perf_counter() - started < 15.0
+    assert len(scene_.world.spheres) == 40_000
+    assert np.array_equal(scene_.world.spheres.positions[-1], [79_998, 1, 0])

@@ -33,12 +33,17 @@ class _Block:
 
 @dataclass
 class Balls:
-    """Balls gathered from [[sphere]] and [[grid]] entries, added to the world in one batch."""
+    """Balls gathered from [[sphere]] and [[grid]] entries, added to the world in one batch.
+
+    Each entry's properties are kept as given (one value for the whole entry, or one per ball) and
+    expanded to one row per ball only once, in ``column``, so gathering is linear in the entries.
+    """
 
     positions: list[np.ndarray] = field(default_factory=list)
-    columns: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in schema.BALL_COLUMNS})
+    values: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in schema.BALL_COLUMNS})
     colors: list[np.ndarray | None] = field(default_factory=list)  # None: the palette
     blocks: list[_Block] = field(default_factory=list)
+    counts: list[int] = field(default_factory=list)
     count: int = 0
 
     def add(
@@ -55,10 +60,20 @@ class Balls:
         self.blocks.append(_Block(self.count, e, key, name))
         self.positions.append(positions)
         for k in schema.BALL_COLUMNS:
-            shape = (n, *_PER_BALL_SHAPE.get(k, ()))
-            self.columns[k].append(np.broadcast_to(np.asarray(props[k], dtype=float), shape))
+            self.values[k].append(np.asarray(props[k], dtype=float))
         self.colors.append(colors)
+        self.counts.append(n)
         self.count += n
+
+    def column(self, k: str) -> np.ndarray:
+        """Property ``k`` of every ball, one row per ball, in batch order."""
+        shape = _PER_BALL_SHAPE.get(k, ())
+        values = self.values[k]
+        if all(v.shape == shape for v in values):  # one value per entry: repeat it for its balls
+            return np.repeat(np.array(values).reshape(-1, *shape), self.counts, axis=0)
+        return np.concatenate(
+            [np.broadcast_to(v, (n, *shape)) for v, n in zip(values, self.counts, strict=True)]
+        )
 
     def owner(self, k: int) -> tuple[Entry, str | None, str | None]:
         """The entry, key and ball name of ball ``k`` of the batch."""

@@ -45,9 +45,8 @@ class Builder:
         plane_colors = self.add_planes(world, planes)
         if balls.count:
             positions = np.concatenate(balls.positions)
-            radii = np.concatenate(balls.columns["radius"])
-            balls.check_overlaps(positions, radii, world)
-            columns = {k: np.concatenate(v) for k, v in balls.columns.items()}
+            columns = {k: balls.column(k) for k in schema.BALL_COLUMNS}
+            balls.check_overlaps(positions, columns["radius"], world)
             columns["hollow"] = columns["hollow"].astype(bool)
             world.add_spheres(positions, **columns)
         position, look_at = self.camera(camera, *given, world)
