@@ -40,9 +40,9 @@ def test_touching_within_the_tolerance_is_not_an_overlap():
 
 
 def test_a_crowd_in_one_place_is_found_quickly():
-    started = time.perf_counter()
+    started = time.process_time()
     assert first_overlap(np.zeros((3000, 3)), np.full(3000, 0.1)) == (0, 1)
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
 
 
 def test_a_crowd_behind_a_clean_grid_is_reported_inside_the_crowd():
@@ -57,9 +57,9 @@ def test_one_huge_ball_beside_a_small_grid_is_fast():
     grid = np.indices((22, 22, 22)).reshape(3, -1).T * 0.25  # 10,648 balls of r = 0.1, 0.05 apart
     positions = np.vstack([grid, [[-1e4 - 1.0, 1.0, 1.0]]])
     radii = np.r_[np.full(len(grid), 0.1), 1e4]
-    started = time.perf_counter()
+    started = time.process_time()
     assert first_overlap(positions, radii, 1e-6) is None
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
     positions[-1, 0] += 1.0  # now it reaches into the grid
     i, j = first_overlap(positions, radii, 1e-6)
     assert j == len(grid) and np.linalg.norm(positions[i] - positions[j]) < radii[j] + 0.1
@@ -69,9 +69,9 @@ def test_a_hundred_thousand_balls_check_in_seconds():
     grid = np.indices((50, 50, 40)).reshape(3, -1).T * 0.25
     positions = grid + np.random.default_rng(1).uniform(-0.02, 0.02, grid.shape)
     radii = np.full(len(positions), 0.1)
-    started = time.perf_counter()
+    started = time.process_time()
     assert first_overlap(positions, radii, 1e-6) is None
-    assert time.perf_counter() - started < 5.0
+    assert time.process_time() - started < 5.0
 
 
 def test_plane_cuts_are_found_on_faces_edges_and_not_beyond_a_square():

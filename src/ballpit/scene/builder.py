@@ -111,10 +111,7 @@ class Builder:
         for key in self.data:
             if key in schema.TABLES:
                 continue
-            line = self.lines.root.key_lines.get(key)
-            if line is None:
-                where = self.lines.table(key) or (self.lines.arrays.get(key) or [None])[0]
-                line = where.header_line if where else None
+            line = self.lines.root.key_lines.get(key) or self.lines.first_header.get(key)
             hint = did_you_mean(key, schema.TABLES)
             owners = [schema.header(n) for n in schema.TABLES if key in schema.KEYS[n]]
             if hint == "" and owners:

@@ -117,13 +117,56 @@ class Table:
     key_lines: dict[str, int]
 
 
-_HEADER = re.compile(r"^\s*(\[\[|\[)\s*([^\[\]#]+?)\s*(\]\]|\])\s*(?:#.*)?$")
+_NAME_END = re.compile(r"[\[\]#]")
 _KEY = re.compile(r"""^\s*("(?:[^"\\]|\\.)*"|'[^']*'|[A-Za-z0-9_-]+)\s*[.=]""")
 
 
-def _unquote(name: str) -> str:
-    parts = [p.strip() for p in re.split(r"\.(?=(?:[^\"']|\"[^\"]*\"|'[^']*')*$)", name)]
-    return ".".join(p[1:-1] if len(p) >= 2 and p[0] == p[-1] and p[0] in "\"'" else p for p in parts)
+def _header(line: str) -> tuple[str, str] | None:
+    """``("[", name)`` or ``("[[", name)`` when the line is a table header, else None.
+
+    A name ends at the first ``[``, ``]`` or ``#``; after the closing brackets only a comment may
+    follow. Linear in the line's length, whatever it holds.
+    """
+    s = line.lstrip()
+    if not s.startswith("["):
+        return None
+    opener = "[[" if s.startswith("[[") else "["
+    rest = s[len(opener) :]
+    end = _NAME_END.search(rest)
+    if end is None:
+        return None
+    name, tail = rest[: end.start()].strip(), rest[end.start() :]
+    closer = "]" * len(opener)
+    if not name or not tail.startswith(closer):
+        return None
+    after = tail[len(closer) :].lstrip()
+    if after and not after.startswith("#"):
+        return None
+    return opener, name
+
+
+def _parts(name: str) -> list[str]:
+    """A dotted TOML name's parts with their quotes removed: ``a."b.c"`` -> ``a``, ``b.c``.
+
+    Linear in the name's length.
+    """
+    parts, start, quote, i = [], 0, None, 0
+    while i < len(name):
+        c = name[i]
+        if quote is not None:
+            if quote == '"' and c == "\\":
+                i += 1
+            elif c == quote:
+                quote = None
+        elif c in "\"'":
+            quote = c
+        elif c == ".":
+            parts.append(name[start:i])
+            start = i + 1
+        i += 1
+    parts.append(name[start:])
+    parts = [p.strip() for p in parts]
+    return [p[1:-1] if len(p) >= 2 and p[0] == p[-1] and p[0] in "\"'" else p for p in parts]
 
 
 class LineIndex:
@@ -137,23 +180,26 @@ class LineIndex:
         self.root = Table(None, {})
         self.tables: dict[str, Table] = {}
         self.arrays: dict[str, list[Table]] = {}
+        self.first_header: dict[str, int] = {}  # by a header's first name part: where it first appears
         current = self.root
         depth = 0  # open brackets/braces of a value continuing onto later lines
         multiline: str | None = None  # the closing delimiter of an open multi-line string
         for number, line in enumerate(text.splitlines(), start=1):
             if multiline is None and depth == 0:
-                header = _HEADER.match(line)
+                header = _header(line)
                 if header:
-                    name = _unquote(header.group(2))
+                    parts = _parts(header[1])
+                    name = ".".join(parts)
+                    self.first_header.setdefault(parts[0], number)
                     current = Table(number, {})
-                    if header.group(1) == "[[":
+                    if header[0] == "[[":
                         self.arrays.setdefault(name, []).append(current)
                     else:
                         self.tables.setdefault(name, current)
                     continue
                 key = _KEY.match(line)
                 if key:
-                    current.key_lines.setdefault(_unquote(key.group(1)), number)
+                    current.key_lines.setdefault(".".join(_parts(key.group(1))), number)
             depth, multiline = _scan_line(line, depth, multiline)
 
     def table(self, name: str) -> Table | None:
@@ -201,8 +247,10 @@ def _find_closing(line: str, start: int, delim: str) -> int:
         if j < 0:
             return -1
         if delim == '"""':
-            backslashes = len(line[:j]) - len(line[:j].rstrip("\\"))
-            if backslashes % 2:
+            k = j  # count the backslashes just before the quotes, without copying the line
+            while k > 0 and line[k - 1] == "\\":
+                k -= 1
+            if (j - k) % 2:
                 i = j + 1
                 continue
         return j
