@@ -239,3 +239,43 @@ def test_header_and_key_lines_still_found():
     assert first.header_line == 3 and first.key_lines == {"quoted.key": 4}
     assert second.header_line == 5 and second.key_lines == {"a": 6}
     assert index.table("x.y.z").header_line == 7 and index.table("x.y.z").key_lines == {"k": 8}
+
+
+# ---------------------------------------------------------------------------------------- messages
+
+
+def test_a_value_with_a_newline_and_terminal_escapes_is_quoted_visibly(tmp_path):
+    text = '[[sphere]]\nposition = [0, 1, 0]\nradius = "a\\nb\\u001b[31mred\\u202e"\n'
+    line = refused(scene(tmp_path, text), "key 'radius': must be a number, got ")
+    assert line.endswith('got "a\\nb\\u001b[31mred\\u202e"') and "\x1b" not in line
+
+
+def test_a_key_with_a_newline_and_terminal_escapes_is_quoted_visibly(tmp_path):
+    text = '[[sphere]]\nposition = [0, 1, 0]\n"bad\\u001b[2Jkey\\nx" = 1\n'
+    line = refused(scene(tmp_path, text), 'sphere #1: unknown key "bad\\u001b[2Jkey\\nx"')
+    assert "\x1b" not in line
+    line = refused(scene(tmp_path, '"\\u001b[2J\\r" = 1\n'), 'unknown table or key "\\u001b[2J\\r"')
+    assert "\x1b" not in line and "\r" not in line
+
+
+def test_a_file_name_with_a_newline_and_an_escape_stays_on_one_line(tmp_path):
+    path = scene(tmp_path, "sphere = 5\n", name="bad\nname\x1b[31m.toml")
+    for command in ("check", "simulate"):
+        code, lines = run_cli(command, path)
+        assert code == 2 and len(lines) == 1
+        assert lines[0].startswith(f"ballpit: {tmp_path}/bad\\nname\\u001b[31m.toml:1: 'sphere' must be")
+
+
+@pytest.mark.parametrize(
+    ("value", "start"),
+    [
+        ("[" + ", ".join(["1"] * 1_000_000) + "]", "got [1, 1, 1, 1,"),
+        ('"' + "x" * 200_000 + '"', 'got "xxxxxxxx'),
+        ("[" + ", ".join(['"' + "y" * 100 + '"'] * 10) + "]", 'got ["yyyy'),
+    ],
+    ids=["a million-element list", "a 200 KB string", "a list of long strings"],
+)
+def test_long_values_are_shortened(tmp_path, value, start):
+    line = refused(scene(tmp_path, f"[[sphere]]\nposition = [0, 1, 0]\nradius = {value}\n"), start)
+    shown = line[line.index("got ") + 4 :]
+    assert len(shown) == 60 and shown.endswith("…")

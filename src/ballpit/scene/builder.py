@@ -16,7 +16,7 @@ from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls
 from .fields import LARGEST, Entry, did_you_mean, show
-from .reading import LineIndex, SceneError
+from .reading import LineIndex, SceneError, quote_key
 
 
 class Builder:
@@ -116,7 +116,7 @@ class Builder:
             owners = [schema.header(n) for n in schema.TABLES if key in schema.KEYS[n]]
             if hint == "" and owners:
                 hint = f" (it belongs inside a table: {' or '.join(owners)})"
-            raise SceneError(self.path, f"unknown table or key '{key}'{hint}", line=line)
+            raise SceneError(self.path, f"unknown table or key {quote_key(key)}{hint}", line=line)
 
     def table(self, name: str) -> Entry:
         """The ``[name]`` table (empty when the file has none)."""

@@ -9,34 +9,56 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 
 from .colours import hex_to_rgb
-from .reading import SceneError, Table
+from .reading import SHOWN, SceneError, Table, quote_key, quoted, shorten, visible
 
 
-def show(value: object, depth: int = 0) -> str:
-    """A value as it would be written in TOML, for error messages (nesting past 8 levels as ``[…]``)."""
+def show(value: object, limit: int = SHOWN) -> str:
+    """A value as it would be written in TOML, for error messages: on one line, with unprintable
+    characters escaped, shortened to ``limit`` characters (nesting past 8 levels as ``[…]``)."""
+    out, size = [], 0
+    for piece in _pieces(value, 0):
+        out.append(piece)
+        size += len(piece)
+        if size > limit:
+            break
+    return shorten("".join(out), limit)
+
+
+def _pieces(value: object, depth: int) -> Iterator[str]:
+    """``show``'s text in pieces, so a huge value is never written out whole."""
     if depth > 8 and isinstance(value, list | dict):
-        return "[…]" if isinstance(value, list) else "{…}"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
+        yield "[…]" if isinstance(value, list) else "{…}"
+    elif isinstance(value, bool):
+        yield "true" if value else "false"
+    elif isinstance(value, float):
         if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, list):
-        return "[" + ", ".join(show(v, depth + 1) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {show(v, depth + 1)}" for k, v in value.items()) + "}"
-    return str(value)
+            yield "nan"
+        elif math.isinf(value):
+            yield "inf" if value > 0 else "-inf"
+        else:
+            yield repr(value)
+    elif isinstance(value, str):
+        yield quoted(value)
+    elif isinstance(value, list):
+        yield "["
+        for i, v in enumerate(value):
+            yield ", " if i else ""
+            yield from _pieces(v, depth + 1)
+        yield "]"
+    elif isinstance(value, dict):
+        yield "{"
+        for i, (k, v) in enumerate(value.items()):
+            yield (", " if i else "") + (k if _BARE.fullmatch(k) else quoted(k)) + " = "
+            yield from _pieces(v, depth + 1)
+        yield "}"
+    else:
+        yield visible(str(value))
 
 
 def is_number(value: object) -> bool:
@@ -50,6 +72,7 @@ def did_you_mean(word: str, options: Iterable[str]) -> str:
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
+_BARE = re.compile(r"[A-Za-z0-9_-]+")
 _COLOR_SHAPE = 'must be "#rrggbb" or [r, g, b] with components 0..1'
 # The range of every number a scene file gives (lengths in m, masses in kg, speeds in m/s, ...), and
 # the least a size, mass or time may be. Within it, whatever the physics forms from the numbers (m·r²,
@@ -92,7 +115,7 @@ class Entry:
             if key not in allowed:
                 hint = did_you_mean(key, allowed)
                 raise SceneError(
-                    self.path, f"unknown key '{key}'{hint}", line=self.line(key), entry=self.label
+                    self.path, f"unknown key {quote_key(key)}{hint}", line=self.line(key), entry=self.label
                 )
 
     def require(self, key: str) -> None:

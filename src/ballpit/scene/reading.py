@@ -12,6 +12,44 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+SHOWN = 60  # characters: a value or key longer than this is shortened in messages, ending in …
+_NAMED = {"\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def _visible(c: str, quoting: bool) -> str:
+    if quoting and c in '\\"':
+        return "\\" + c
+    if c.isprintable():
+        return c
+    return _NAMED.get(c) or (f"\\u{ord(c):04x}" if ord(c) <= 0xFFFF else f"\\U{ord(c):08x}")
+
+
+def visible(text: str) -> str:
+    """``text`` with newlines, terminal escapes and other unprintable characters written as escapes."""
+    return "".join(_visible(c, False) for c in text)
+
+
+def quoted(text: str, limit: int = SHOWN) -> str:
+    """``text`` as a TOML basic string, escapes visible, shortened to ``limit`` characters."""
+    out, size = ['"'], 1
+    for c in text:
+        out.append(_visible(c, True))
+        size += len(out[-1])
+        if size >= limit:
+            break
+    return shorten("".join(out) + '"', limit)
+
+
+def shorten(text: str, limit: int = SHOWN) -> str:
+    """``text`` cut to ``limit`` characters, the last one ``…``, when it is longer."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def quote_key(key: str) -> str:
+    """A key for a message: ``'radius'`` when it is a bare key, else a quoted, shortened string."""
+    return f"'{key}'" if _BARE_KEY.fullmatch(key) else quoted(key)
+
 
 class SceneError(ValueError):
     """A problem with a scene file, as one line naming the file, line, entry, key and value."""
@@ -30,12 +68,12 @@ class SceneError(ValueError):
         self.entry = entry
         self.key = key
         self.problem = problem
-        where = f"{path}:{line}" if line is not None else f"{path}"
-        parts = [where]
+        where = visible(str(path))
+        parts = [f"{where}:{line}" if line is not None else where]
         if entry:
             parts.append(entry)
         if key:
-            parts.append(f"key '{key}'")
+            parts.append(f"key {quote_key(key)}")
         parts.append(problem)
         super().__init__(": ".join(parts))
 
