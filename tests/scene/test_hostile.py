@@ -17,7 +17,7 @@ import pytest
 
 from ballpit import cli
 from ballpit.scene import read_scene
-from ballpit.scene.reading import LineIndex
+from ballpit.scene.lines import LineIndex
 
 
 def run_cli(*args: str | Path) -> tuple[int, list[str]]:

@@ -6,10 +6,10 @@ every error is one ``SceneError`` line:
 
     scenes/x.toml:12: sphere #3: key 'radius': must be positive, got -1.0
 
-One module per job: ``reading`` (file, TOML, line index), ``fields`` (typed readers), ``schema``
-(keys and defaults), ``builder``, ``balls`` (the batch of balls), ``layout`` (grids), ``overlap`` (the
-start-overlap check), ``colours`` and ``appearance`` (what a scene holds besides the physics),
-``loading`` (entry points, bundled scenes).
+One module per job: ``reading`` (file, TOML, SceneError), ``lines`` (the line index), ``fields``
+(typed readers), ``schema`` (keys and defaults), ``builder``, ``balls`` (the batch of balls),
+``layout`` (grids), ``overlap`` (the start-overlap check), ``colours`` and ``appearance`` (what a
+scene holds besides the physics), ``loading`` (entry points, bundled scenes).
 """
 
 from .appearance import Appearance, Scene, default_appearance, frame_camera, scene_of

@@ -16,7 +16,8 @@ from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls
 from .fields import LARGEST, Entry, did_you_mean, show
-from .reading import LineIndex, SceneError, quote_key
+from .lines import LineIndex
+from .reading import SceneError, quote_key
 
 
 class Builder:

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from .colours import hex_to_rgb
-from .reading import SHOWN, SceneError, Table, quote_key, quoted, shorten, visible
+from .lines import Table
+from .reading import SHOWN, SceneError, quote_key, quoted, shorten, visible
 
 
 def show(value: object, limit: int = SHOWN) -> str:
