@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -126,19 +125,22 @@ def scene_files(draw: st.DrawFn) -> str:
 
 # ---------------------------------------------------------------------------------------- the property
 
-FILE = Path(tempfile.mkdtemp(prefix="ballpit-fuzz-")) / "fuzz.toml"
+
+@pytest.fixture(scope="module")
+def fuzz_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("fuzz") / "fuzz.toml"
 
 
-def check_one(text: str) -> None:
-    FILE.write_text(text, encoding="utf-8", errors="surrogatepass")
+def check_one(path: Path, text: str) -> None:
+    path.write_text(text, encoding="utf-8", errors="surrogatepass")
     outcomes = []
     for command in (["check"], ["simulate", "--duration", "0.01", "--dt", "0.005", "--quiet"]):
-        code, lines = run_cli(command[0], FILE, *command[1:])
+        code, lines = run_cli(command[0], path, *command[1:])
         if code == 0:
             assert lines == [], (command[0], text, lines)
         else:
             assert code == 2 and len(lines) == 1, (command[0], code, text, lines[:5])
-            assert lines[0].startswith(f"ballpit: {FILE}"), lines[0]
+            assert lines[0].startswith(f"ballpit: {path}"), lines[0]
             assert "Traceback" not in lines[0] and "\x1b" not in lines[0]
         outcomes.append((code, lines))
     assert outcomes[0] == outcomes[1] or outcomes[0][0] == outcomes[1][0] == 0, outcomes
@@ -152,8 +154,8 @@ def check_one(text: str) -> None:
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 @given(scene_files())
-def test_generated_hostile_scene_files_give_one_line_or_run(text):
-    check_one(text)
+def test_generated_hostile_scene_files_give_one_line_or_run(fuzz_file, text):
+    check_one(fuzz_file, text)
 
 
 @pytest.mark.parametrize(

@@ -120,11 +120,14 @@ class Entry:
                 )
 
     def require(self, key: str) -> None:
+        """Refuse the entry when ``key`` is missing."""
         if key not in self.data:
             raise self.error(None, f"missing required key '{key}'")
 
-    def number(self, key: str, default: float | None, *, positive: bool = False, nonnegative: bool = False):
-        """A finite number (optionally > 0 or ≥ 0) as a float."""
+    def number(
+        self, key: str, default: float | None, *, positive: bool = False, nonnegative: bool = False
+    ) -> float | None:
+        """A number within ±1e9 (optionally > 0, then at least 1e-9, or ≥ 0) as a float."""
         if key not in self.data:
             return default
         value = self.data[key]
@@ -144,6 +147,7 @@ class Entry:
         return x
 
     def integer(self, key: str, default: int, *, minimum: int = 0) -> int:
+        """A whole number (``true`` is not one) of at least ``minimum``."""
         if key not in self.data:
             return default
         value = self.data[key]
@@ -154,6 +158,7 @@ class Entry:
         return value
 
     def boolean(self, key: str, default: bool) -> bool:
+        """``true`` or ``false``."""
         if key not in self.data:
             return default
         value = self.data[key]
