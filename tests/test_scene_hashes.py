@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit.scene import load_scene
+from ballpit.scene import read_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SECONDS = 2.0
@@ -35,8 +35,8 @@ HASHES = {
 
 def scene_hash(path: Path, seconds: float = SECONDS) -> str:
     """SHA-256 of every step's contacts, then the final ball states and time, after ``seconds``."""
-    world = load_scene(path)
-    dt = world.scene.timestep
+    scene = read_scene(path)
+    world, dt = scene.world, scene.timestep
     digest = hashlib.sha256()
     for _ in range(round(seconds / dt)):
         c = world.step(dt)

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ballpit
 from ballpit import cli, writers
 from ballpit.physics import Contacts
+from ballpit.scene import read_scene
 from ballpit.simulate import step_plan
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -42,7 +42,8 @@ def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict, dic
 
     Impacts are the contacts whose pair (kind, a, b) was not among the step before's contacts.
     """
-    world = ballpit.load_scene(scene)
+    loaded = read_scene(scene)
+    world = loaded.world
     balls = world.spheres
     n = len(balls)
     records: list[np.ndarray] = []
@@ -60,7 +61,7 @@ def reference(scene: Path, duration: float, every: int) -> tuple[dict, dict, dic
         records.append(row)
 
     record()
-    plan = step_plan(duration, world.scene.timestep)
+    plan = step_plan(duration, loaded.timestep)
     total, done = sum(k for k, _ in plan), 0
     before: set[tuple[int, int, int]] = set()
     for k, h in plan:

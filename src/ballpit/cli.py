@@ -213,14 +213,14 @@ def _looks_like_scene(arg: str) -> bool:
 
 
 def _load(scene_arg: str):
-    from .scene import load_scene, resolve_scene_path
+    from .scene import read_scene, resolve_scene_path
 
-    return load_scene(resolve_scene_path(scene_arg))
+    return read_scene(resolve_scene_path(scene_arg))
 
 
 def _check(args: argparse.Namespace) -> int:
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     duration = f", suggested duration {info.duration:g} s" if info.duration else ""
     print(
         f"{info.path}: ok: {len(world.spheres)} balls, {len(world.planes)} planes, {world.integrator}, "
@@ -233,8 +233,8 @@ def _simulate(args: argparse.Namespace) -> int:
     from .simulate import MAX_STEPS, format_summary, run, step_count
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     if args.integrator:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
@@ -266,6 +266,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 events=events,
                 events_kind=args.events_kind,
                 progress=not args.quiet,
+                name=info.name,
             )
         except FloatingPointError as e:
             print(
@@ -312,8 +313,7 @@ def _render(args: argparse.Namespace) -> int:
     from .writers import OutputError, check_name_lengths
 
     path = resolve_scene_path(args.scene)
-    world = _load(str(path))
-    duration = args.duration or world.scene.duration or 10.0
+    duration = args.duration or _load(str(path)).duration or 10.0
     out = Path(args.out)
     check_name_lengths(out, "--out")
     folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix

@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from tqdm import tqdm
 
-from .physics import Contacts, World
+from .physics import DEFAULT_TIMESTEP, Contacts, World
 from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from .writers import EventWriter, TrajectoryWriter
 
@@ -139,18 +139,19 @@ def run(
     events: EventWriter | None = None,
     events_kind: str = "impacts",
     progress: bool = False,
+    name: str = "simulate",
 ) -> RunSummary:
     """Advance ``world`` by ``duration`` seconds in steps of ``dt``, recording every ``every``-th step.
 
-    The trajectory gets the initial state, every ``every``-th step and the final state. ``events``
-    gets the impacts (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step.
-    The writers are not committed here; the caller commits them on success or discards them on failure.
+    ``dt`` defaults to the physics' default timestep; ``name`` labels the progress bar. The trajectory
+    gets the initial state, every ``every``-th step and the final state. ``events`` gets the impacts
+    (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step. The writers are
+    not committed here; the caller commits them on success or discards them on failure.
     """
     if events_kind not in EVENT_KINDS:
         raise ValueError(f"events_kind must be one of {', '.join(EVENT_KINDS)}, got {events_kind!r}")
     keep = ImpactFilter() if events is not None and events_kind == "impacts" else None
-    scene = getattr(world, "scene", None)
-    dt = dt if dt is not None else (scene.timestep if scene is not None else 1.0 / 240.0)
+    dt = dt if dt is not None else DEFAULT_TIMESTEP
     plan = step_plan(duration, dt)
     total = sum(n for n, _ in plan)
     balls = world.spheres
@@ -172,7 +173,7 @@ def run(
         delay=1.0,
         leave=False,
         dynamic_ncols=True,
-        desc=getattr(scene, "name", "simulate"),
+        desc=name,
     )
     began = clock.perf_counter()
     try:

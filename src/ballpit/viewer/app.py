@@ -39,7 +39,8 @@ def title(scene_name: str, fps: float) -> str:
 
 
 class Viewer:
-    """One window on one Simulation."""
+    """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
+    file ``scene_path`` (the bundled demo by default)."""
 
     def __init__(
         self,
@@ -57,10 +58,10 @@ class Viewer:
         from .renderer import Renderer
 
         if world is None:
-            import ballpit
+            from ballpit.scene import read_scene
 
             scene_path = Path(scene_path) if scene_path is not None else default_scene()
-            world = ballpit.load_scene(scene_path)
+            world = read_scene(scene_path)
         self.sim = Simulation(world, scene_path)
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)

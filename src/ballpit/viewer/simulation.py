@@ -21,9 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ballpit.physics.profile import RunProfile
-
-from .appearance import Appearance, appearance_of
+from ..physics.profile import RunProfile
+from ..scene import Appearance, Scene, read_scene, scene_of
 
 MAX_FRAME_SECONDS = 0.25
 TRAIL_POINT_BUDGET = 200_000  # trail samples kept over all balls
@@ -36,12 +35,6 @@ class Phase(Enum):
     WAITING = "waiting: press X to drop"
     RUNNING = "running"
     PAUSED = "paused: Space resumes, N steps"
-
-
-def _default_loader(path: Path) -> object:
-    import ballpit
-
-    return ballpit.load_scene(path)
 
 
 def _file_signature(path: Path | None) -> tuple[int, int] | None:
@@ -81,17 +74,21 @@ class Trails:
 
 
 class Simulation:
-    """A World being watched: the run phase, the fixed-step clock and what the viewer draws from it."""
+    """A World being watched: the run phase, the fixed-step clock and what the viewer draws from it.
+
+    Give it a Scene (from ``read_scene``), or a World built in code and optionally the file to reload;
+    ``loader`` reads that file again (``read_scene`` by default).
+    """
 
     def __init__(
         self,
-        world: object,
+        world: Scene | object,
         path: Path | None = None,
-        loader: Callable[[Path], object] | None = None,
+        loader: Callable[[Path], Scene] | None = None,
         step_budget: float = 0.05,
         clock: Callable[[], float] = time.perf_counter,
     ) -> None:
-        self.loader = loader or _default_loader
+        self.loader = loader or read_scene
         self.step_budget = step_budget
         self.clock = clock
         self.time_scale = 1.0
@@ -99,13 +96,15 @@ class Simulation:
         self.message: str = ""
         self.generation = 0  # bumps whenever the world is replaced, so the renderer rebuilds geometry
         self.dropped_seconds = 0.0  # simulated time skipped because physics could not keep up
-        self._install(world, path)
+        self._install(scene_of(world, path))
 
     # ------------------------------------------------------------------ world management
-    def _install(self, world: object, path: Path | None) -> None:
+    def _install(self, scene: Scene) -> None:
+        world = scene.world
+        self.scene = scene
         self.world = world
-        self.appearance: Appearance = appearance_of(world, path)
-        self.path = self.appearance.path
+        self.appearance: Appearance = scene.appearance
+        self.path = scene.path
         self.initial = copy.deepcopy(world)
         self._signature = _file_signature(self.path)
         self._reset_dynamics()
@@ -133,7 +132,7 @@ class Simulation:
 
     @property
     def timestep(self) -> float:
-        return self.appearance.timestep
+        return self.scene.timestep
 
     @property
     def ball_count(self) -> int:
@@ -202,12 +201,12 @@ class Simulation:
             return False
         self._signature = _file_signature(self.path)
         try:
-            world = self.loader(self.path)
+            scene = self.loader(self.path)
         except Exception as exc:  # any failure: the viewer must stay up with the old world
             self.error = f"reload of {self.path.name} failed: {_describe(exc)}"
             print(f"ballpit: {self.error} (keeping the last good scene)", file=sys.stderr, flush=True)
             return False
-        self._install(world, self.path)
+        self._install(scene)
         self.error = None
         self.message = f"reloaded {self.path.name}: press X to drop"
         return True
