@@ -120,7 +120,12 @@ def _run(
     steps = 0
     for n, h in step_plan(duration, dt):
         for _ in range(n):
-            world.step(h)
+            try:
+                world.step(h)
+            except FloatingPointError as e:
+                raise FloatingPointError(
+                    f"the {integrator} run failed at t = {world.time:.6g} s: {e}"
+                ) from None
             record(world)
             steps += 1
             bar.update()
@@ -238,7 +243,7 @@ def main(args: argparse.Namespace) -> int:
             print(f"ballpit: {scene.name}: {e}", file=sys.stderr)
             return EXIT_BAD_INPUT
         except FloatingPointError as e:
-            print(f"ballpit: {scene.name}: a run failed: {e}", file=sys.stderr)
+            print(f"ballpit: {scene.name}: {e}", file=sys.stderr)
             return EXIT_FAILED
         if plot is not None:
             runs: Sequence[tuple[str, EnergyTrace, bool]] = [
