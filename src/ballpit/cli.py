@@ -18,7 +18,7 @@ from typing import NoReturn
 
 from . import __version__
 
-COMMANDS = ("view", "check", "simulate", "render", "bench", "scenes")
+COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
@@ -154,7 +154,27 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--plot", type=Path, metavar="FILE", help="plot kinetic, potential and total energy "
+                   "over time: .png, .svg or .pdf")  # fmt: skip
     p.set_defaults(handler=_simulate)
+
+    p = sub.add_parser(
+        "compare",
+        help="run a scene under Euler, RK2 and RK4 and compare energy drift and end positions",
+        description="Run the scene under Euler, RK2 and RK4 (each from its initial state) and RK4 at a "
+        "quarter of the step as a reference; print each one's total-energy drift and how far its balls "
+        "end from the reference's.",
+    )
+    p.add_argument("scene", help="a scene file, or a bundled scene's name")
+    p.add_argument("--duration", type=_positive, metavar="S", help="seconds to simulate (default: the "
+                   "scene's [world] duration, else 10)")  # fmt: skip
+    p.add_argument(
+        "--dt", type=_positive, metavar="S", help="seconds per step (default: the scene's timestep)"
+    )
+    p.add_argument("--plot", type=Path, metavar="FILE", help="plot each integrator's total-energy drift "
+                   "over time: .png, .svg or .pdf")  # fmt: skip
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_compare)
 
     p = sub.add_parser("render", help="render a scene offscreen to a GIF or a folder of PNG frames")
     p.add_argument("scene", help="a scene file, or a bundled scene's name")
@@ -249,6 +269,12 @@ def _simulate(args: argparse.Namespace) -> int:
         raise OutputError(f"{args.out}: --out and --events must be different files")
     writers: list = []
     try:
+        from .plots import energy_plot  # opened first: a bad --plot path fails before the run
+
+        plot = energy_plot(
+            args.plot, f"{info.name}: energy ({world.integrator}, steps of {dt * 1000:.4g} ms)"
+        )
+        writers += [plot] if plot is not None else []
         trajectory = events = None
         if args.out is not None:
             trajectory = TrajectoryWriter(args.out, len(world.spheres))
@@ -261,6 +287,7 @@ def _simulate(args: argparse.Namespace) -> int:
                 world,
                 duration,
                 dt,
+                observe=plot.record if plot is not None else None,
                 every=args.every,
                 trajectory=trajectory,
                 events=events,
@@ -284,10 +311,18 @@ def _simulate(args: argparse.Namespace) -> int:
             print(line)
         if trajectory is not None:
             print(f"  wrote {args.out} ({summary.records} records x {len(world.spheres)} balls)")
+        if plot is not None:
+            print(f"  wrote {args.plot} (energies at {len(plot.record)} times)")
         if events is not None:
             what = "impacts" if args.events_kind == "impacts" else "contacts"
             print(f"  wrote {args.events} ({events.count} {what})")
     return EXIT_OK
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from .compare import main as compare_main
+
+    return compare_main(args)
 
 
 def _view(args: argparse.Namespace) -> int:

@@ -6,6 +6,7 @@ state arrays once per recorded step into the writers' buffers; nothing is create
 
 from __future__ import annotations
 
+import collections.abc
 import math
 import time as clock
 from dataclasses import dataclass, fields
@@ -134,6 +135,7 @@ def run(
     duration: float,
     dt: float | None = None,
     *,
+    observe: collections.abc.Callable[[World], None] | None = None,  # called at the start and after each step
     every: int = 1,
     trajectory: TrajectoryWriter | None = None,
     events: EventWriter | None = None,
@@ -164,6 +166,8 @@ def run(
             )
 
     record()
+    if observe is not None:
+        observe(world)
     counts = np.zeros(2, dtype=np.int64)
     done = 0
     bar = tqdm(
@@ -188,6 +192,8 @@ def run(
                 if done % every == 0 or done == total:
                     record()
                 bar.update()  # cheap next to a step; tqdm redraws at most ~10 times a second
+                if observe is not None:
+                    observe(world)
     finally:
         bar.close()
     wall = clock.perf_counter() - began
