@@ -49,11 +49,10 @@ def open_scene(scene: str | Path) -> SceneInput:
 
     Raises ``SceneError`` (one line) for a bad or missing file.
     """
-    from .scene import load_scene, resolve_scene_path
+    from .scene import read_scene, resolve_scene_path
 
-    world = load_scene(resolve_scene_path(scene))
-    info = world.scene
-    return SceneInput(world=world, timestep=info.timestep, duration=info.duration, name=info.name)
+    info = read_scene(resolve_scene_path(scene))
+    return SceneInput(world=info.world, timestep=info.timestep, duration=info.duration, name=info.name)
 
 
 @dataclass(frozen=True, eq=False)
