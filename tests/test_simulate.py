@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import re
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 
 import ballpit
@@ -15,6 +20,8 @@ from ballpit.simulate import (
     run,
     step_plan,
 )
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_step_plan_ends_exactly_and_refuses_more_than_max_steps():
@@ -70,3 +77,35 @@ def test_small_but_real_energies_are_kept():
     assert "kinetic 1e-09" in format_summary(summary, "x", "rk4", 0.01, 1)[-1]
     assert "potential 0)" in format_summary(RunSummary(1, 1.0, 1.0, 0, 0, 0, start, Energy(1.0, 1e-14)),
                                             "x", "rk4", 0.01, 1)[-1]  # fmt: skip
+
+
+def read_profile(stdout: str) -> tuple[dict[str, float], str]:
+    """The stage times (ms per step) and the counts line that ``simulate --profile`` printed."""
+    ms, counts = {}, ""
+    for line in stdout.splitlines():
+        match = re.fullmatch(r"\s+(.+?)\s+(\d+\.\d+) ms", line)
+        if match:
+            ms[match.group(1)] = float(match.group(2))
+        elif "intervals/step" in line:
+            counts = line
+    return ms, counts
+
+
+@pytest.mark.parametrize(("scene", "crowded"), [("slopes", False), ("pile", True)])
+def test_profile_prints_the_time_of_every_stage_and_the_counts_per_step(scene, crowded):
+    from ballpit.physics.profile import STAGES
+
+    command = ["simulate", f"scenes/{scene}.toml", "--duration", "0.8", "--profile", "-q"]
+    r = subprocess.run(
+        [sys.executable, "-m", "ballpit", *command], capture_output=True, text=True, cwd=ROOT, timeout=600
+    )
+    assert r.returncode == 0, r.stderr
+    ms, counts = read_profile(r.stdout)
+    assert set(STAGES) | {"step"} == set(ms), r.stdout
+    assert 0 < sum(ms[s] for s in STAGES) <= ms["step"] * 1.01 + 0.002  # the stages are inside the step
+    steps = int(re.search(r"over (\d+) steps", r.stdout).group(1))
+    assert steps == 192  # 0.8 s at 240 steps per second
+    intervals = float(re.search(r"intervals/step (\d+\.\d+)", counts).group(1))
+    assert intervals >= 1.0
+    taken_whole = int(re.search(r"crowded (\d+)/192", counts).group(1))
+    assert (taken_whole > 0) == crowded, counts

@@ -12,11 +12,14 @@ import math
 import os
 import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+
+if TYPE_CHECKING:
+    from .physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -156,6 +159,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     p.add_argument("--plot", type=Path, metavar="FILE", help="plot kinetic, potential and total energy "
                    "over time: .png, .svg or .pdf")  # fmt: skip
+    p.add_argument("--profile", action="store_true", help="print where the step's time went, stage by "
+                   "stage, with intervals, pairs and contacts per step")  # fmt: skip
     p.set_defaults(handler=_simulate)
 
     p = sub.add_parser(
@@ -249,6 +254,25 @@ def _check(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+class StepTotals:
+    """Adds up ``World.profile`` after every step of a run (``simulate --profile``), passing the world
+    on to another observer (the energy plot) if there is one."""
+
+    def __init__(self, then: Callable[[World], None] | None) -> None:
+        from .physics.profile import RunProfile
+
+        self.totals = RunProfile()
+        self.then = then
+        self._started = False
+
+    def observe(self, world: World) -> None:
+        if self._started:  # the first call comes before the first step
+            self.totals.add(world.profile)
+        self._started = True
+        if self.then is not None:
+            self.then(world)
+
+
 def _simulate(args: argparse.Namespace) -> int:
     from .simulate import MAX_STEPS, format_summary, run, step_count
     from .writers import EventWriter, OutputError, TrajectoryWriter
@@ -282,12 +306,13 @@ def _simulate(args: argparse.Namespace) -> int:
         if args.events is not None:
             events = EventWriter(args.events)
             writers.append(events)
+        profile = StepTotals(plot.record if plot is not None else None) if args.profile else None
         try:
             summary = run(
                 world,
                 duration,
                 dt,
-                observe=plot.record if plot is not None else None,
+                observe=profile.observe if profile is not None else plot.record if plot is not None else None,
                 every=args.every,
                 trajectory=trajectory,
                 events=events,
@@ -313,6 +338,10 @@ def _simulate(args: argparse.Namespace) -> int:
             print(f"  wrote {args.out} ({summary.records} records x {len(world.spheres)} balls)")
         if plot is not None:
             print(f"  wrote {args.plot} (energies at {len(plot.record)} times)")
+    if profile is not None:
+        print(f"step profile: mean per step over {profile.totals.steps} steps ({world.integrator})")
+        for line in profile.totals.lines():
+            print(f"  {line}")
         if events is not None:
             what = "impacts" if args.events_kind == "impacts" else "contacts"
             print(f"  wrote {args.events} ({events.count} {what})")
