@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .physics import World
-from .simulate import step_plan
+from .simulate import progress_bar, step_plan
 
 INTEGRATORS = ("euler", "rk2", "rk4")
 REFERENCE_INTEGRATOR = "rk4"
@@ -148,15 +148,7 @@ def compare(
             f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"
         )
     steps = sum(n for n, _ in step_plan(duration, dt))
-    bar = tqdm(
-        total=len(INTEGRATORS) * steps + ref_steps,
-        unit="step",
-        disable=None if progress else True,  # None: only on a terminal
-        delay=1.0,
-        leave=False,
-        dynamic_ncols=True,
-        desc=name,
-    )
+    bar = progress_bar(len(INTEGRATORS) * steps + ref_steps, name, progress)
     try:
         runs = []
         for integrator in INTEGRATORS:

@@ -130,6 +130,19 @@ def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
     return plan
 
 
+def progress_bar(total: int, name: str, progress: bool) -> tqdm:
+    """The steps' progress bar on stderr: only on a terminal, after a second, gone when done."""
+    return tqdm(
+        total=total,
+        unit="step",
+        disable=None if progress else True,  # None: only on a terminal
+        delay=1.0,
+        leave=False,
+        dynamic_ncols=True,
+        desc=name,
+    )
+
+
 def run(
     world: World,
     duration: float,
@@ -170,15 +183,7 @@ def run(
         observe(world)
     counts = np.zeros(2, dtype=np.int64)
     done = 0
-    bar = tqdm(
-        total=total,
-        unit="step",
-        disable=None if progress else True,  # None: only on a terminal
-        delay=1.0,
-        leave=False,
-        dynamic_ncols=True,
-        desc=name,
-    )
+    bar = progress_bar(total, name, progress)
     began = clock.perf_counter()
     try:
         for n, h in plan:

@@ -188,12 +188,42 @@ _EVENT_TYPES = {
 }
 
 
-class TrajectoryWriter:
+class _SpooledOutput:
+    """Commit or discard for a writer whose rows go to ``out`` (CSV text) or ``spool`` (.npz columns,
+    typed by ``types`` when the archive is written)."""
+
+    path: Path
+    out: AtomicFile
+    spool: ColumnSpool | None
+    types: dict
+
+    def _flush(self) -> None:
+        raise NotImplementedError
+
+    def commit(self) -> None:
+        self._flush()
+        with _writing(self.path):
+            if self.spool is not None:
+                self.spool.write_npz(self.out.file, self.types)
+                self.spool.close()
+            self.out.commit()
+
+    def discard(self) -> None:
+        try:
+            if self.spool is not None:
+                self.spool.close()
+        finally:
+            self.out.discard()
+
+
+class TrajectoryWriter(_SpooledOutput):
     """Every ball's state at the recorded times: one row per ball per record.
 
     ``record`` copies the state into a preallocated buffer; full buffers go to disk as CSV text, or
     to the ``.npz``'s column spool.
     """
+
+    types = _TRAJECTORY_TYPES
 
     def __init__(self, path: Path, n_balls: int) -> None:
         self.path = path
@@ -233,24 +263,11 @@ class TrajectoryWriter:
                 self.spool.add(rows)
         self.filled = 0
 
-    def commit(self) -> None:
-        self._flush()
-        with _writing(self.path):
-            if self.spool is not None:
-                self.spool.write_npz(self.out.file, _TRAJECTORY_TYPES)
-                self.spool.close()
-            self.out.commit()
 
-    def discard(self) -> None:
-        try:
-            if self.spool is not None:
-                self.spool.close()
-        finally:
-            self.out.discard()
-
-
-class EventWriter:
+class EventWriter(_SpooledOutput):
     """Every contact the solver resolved: time, kind, the two bodies, point, normal and impulse."""
+
+    types = _EVENT_TYPES
 
     def __init__(self, path: Path) -> None:
         self.path = path
@@ -302,18 +319,3 @@ class EventWriter:
         rows[:, 7:10] = c.normal
         rows[:, 10] = c.impulse
         self.out.file.write((self.row_format * len(c)) % tuple(rows.ravel().tolist()))
-
-    def commit(self) -> None:
-        self._flush()
-        with _writing(self.path):
-            if self.spool is not None:
-                self.spool.write_npz(self.out.file, _EVENT_TYPES)
-                self.spool.close()
-            self.out.commit()
-
-    def discard(self) -> None:
-        try:
-            if self.spool is not None:
-                self.spool.close()
-        finally:
-            self.out.discard()
