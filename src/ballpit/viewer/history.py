@@ -1,6 +1,7 @@
 """The viewer's history: every physics step of the last ``keep_seconds`` of a run, kept compactly.
 
-A ``World.snapshot()`` is taken every ``every`` steps (an anchor); any step in between is reached by
+A ``World.snapshot()`` is taken every ``every`` steps (an anchor; wider apart for scenes with many
+balls, to bound the memory); any step in between is reached by
 restoring the nearest anchor at or before it and stepping on. Stepping is deterministic, so the state
 reached is bit for bit the one the run had. The integrator used for each step is remembered too, so a
 run whose integrator was switched live (keys 1/2/3) re-steps exactly.
@@ -17,6 +18,8 @@ from typing import Any
 
 ANCHOR_SECONDS = 0.25  # simulated seconds between snapshots
 KEEP_SECONDS = 30.0  # at least this much simulated time stays reachable
+ANCHOR_BALL_BUDGET = 500_000  # balls × anchors held at most: big scenes space their anchors wider
+DENSE_BALL_BUDGET = 200_000  # balls × snapshots kept of the steps last re-stepped
 
 
 class History:
@@ -34,7 +37,10 @@ class History:
     ) -> None:
         self.world = world
         self.timestep = float(timestep)
+        balls = max(len(world.spheres), 1)
+        anchor_seconds = max(anchor_seconds, keep_seconds * balls / ANCHOR_BALL_BUDGET)
         self.every = max(1, round(anchor_seconds / self.timestep))
+        self._dense_cap = min(2 * self.every, max(4, DENSE_BALL_BUDGET // balls))
         self.keep_steps = max(1, math.ceil(keep_seconds / self.timestep - 1e-9))
         self.current = start  # the step the world is at now
         self.latest = start  # the newest step kept
@@ -133,7 +139,7 @@ class History:
             self.world.integrator = integrators[self.current - base]
             self.last_contacts = self.world.step(self.timestep)
             self.current += 1
-            if len(self._dense) < 2 * self.every:
+            if len(self._dense) < self._dense_cap:
                 self._dense[self.current] = self.world.snapshot()
         if self.current < self.latest:
             self.world.integrator = integrators[self.current - base]
