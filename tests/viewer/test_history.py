@@ -104,3 +104,11 @@ def test_a_change_by_hand_becomes_an_anchor():
     assert state_bytes(world) == states[5]
     history.seek(30)
     assert state_bytes(world) == changed
+
+
+def test_scenes_with_many_balls_space_their_snapshots_wider():
+    world = ballpit.World()
+    world.add_spheres(np.column_stack([np.arange(20_000.0), np.ones(20_000), np.zeros(20_000)]), radius=0.1)
+    history = History(world, DT)  # 30 s × 20,000 balls over a budget of 500,000 ball-states: 1.2 s
+    assert history.every == round(1.2 / DT)
+    assert History(ballpit.load_scene(SCENES / "slopes.toml"), DT).every == round(0.25 / DT)

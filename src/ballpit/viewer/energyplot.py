@@ -95,7 +95,7 @@ def legend(series: dict[str, np.ndarray], ghosts: bool) -> list[tuple[str, tuple
             items.append(("potential", color))
         else:
             name = key[len("total ") :]
-            items.append((f"total {LABELS[name]}" if ghosts else "total", color))
+            items.append((f"E {LABELS[name]}" if ghosts else "total", color))
     return items
 
 
@@ -126,6 +126,10 @@ def plot_shapes(
         def py(v: np.ndarray) -> np.ndarray:
             return y0 + pad_y + (v - low) / (high - low) * (h - 2 * pad_y)
 
+        # one sample per 2 px: shorter segments can drop out of the rasteriser, leaving dotted lines
+        keep = np.r_[True, np.diff(np.floor(px / 2.0)) != 0]
+        keep[-1] = True
+        px, series = px[keep], {k: v[keep] for k, v in series.items()}
         zero = float(py(np.array(0.0)))
         lines.append(_vertices(np.array([[x0, zero], [x0 + w, zero]]), ZERO_COLOR))
         for key, color in curve_colors(series, ghosts).items():

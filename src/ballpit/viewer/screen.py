@@ -139,17 +139,22 @@ class ScreenOverlay:
         x, y, _, h = rect
         texts = [(f"energy, last {self.sim.timeline.energy.window:g} s   {low:.3g} … {high:.3g} J",
                   TEXT_COLOR, x, y + h + 4)]  # fmt: skip
-        cx = x + 6
         for text, color in items:
-            rgba = tuple(round(c * 255) for c in color[:3]) + (255,)
-            texts.append((text, rgba, cx, y + 4))
-            cx += 8 * len(text) + 14
+            texts.append((text, tuple(round(c * 255) for c in color[:3]) + (255,), 0, y + 4))
         while len(self.plot_labels) < len(texts):
             self.plot_labels.append(pyglet.text.Label(
                 "", font_name=FONT, font_size=FONT_SIZE, anchor_y="bottom", batch=self.plot_batch
             ))  # fmt: skip
-        for label, (text, color, lx, ly) in zip(self.plot_labels, texts, strict=False):
-            label.text, label.color, label.x, label.y = text, color, lx, ly
+        cx = x + 6
+        for index, (label, (text, color, lx, ly)) in enumerate(zip(self.plot_labels, texts, strict=False)):
+            if label.text != text:
+                label.text = text
+            label.color, label.y = color, ly
+            if index == 0:
+                label.x = lx
+            else:  # the legend, one after another along the bottom of the plot
+                label.x = cx
+                cx += label.content_width + 12
         for label in self.plot_labels[len(texts) :]:
             label.text = ""
 
