@@ -127,6 +127,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("view", help="open the viewer on SCENE (default: the bundled slopes demo)")
     p.add_argument("scene", nargs="?", help="a scene file, or a bundled scene's name")
+    p.add_argument(
+        "--replay",
+        type=Path,
+        metavar="FILE",
+        help="play a trajectory (.npz or .csv) written by 'simulate --out' or '--record'; "
+        "the scene gives the planes, radii and colours",
+    )
     p.set_defaults(handler=_view)
 
     p = sub.add_parser("check", help="validate a scene file")
@@ -357,10 +364,20 @@ def _compare(args: argparse.Namespace) -> int:
 def _view(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
 
-    path = None
+    path = world = None
     if args.scene is not None:
         path = resolve_scene_path(args.scene)
-        _load(str(path))  # a bad scene gets its one-line error before a window opens
+        world = _load(str(path))  # a bad scene gets its one-line error before a window opens
+    trajectory = None
+    if args.replay is not None:
+        from .viewer.replay import TrajectoryError, read_trajectory
+
+        world = world if world is not None else _load("slopes")
+        try:
+            trajectory = read_trajectory(args.replay, n_balls=len(world.spheres))
+        except TrajectoryError as e:
+            print(f"ballpit: {e}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     try:
         from .viewer.app import run
     except ImportError as e:
@@ -369,7 +386,7 @@ def _view(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_FAILED
-    return int(run(path) or EXIT_OK)
+    return int(run(path, trajectory=trajectory) or EXIT_OK)
 
 
 def _render(args: argparse.Namespace) -> int:

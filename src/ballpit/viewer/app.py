@@ -48,6 +48,7 @@ class Viewer:
         scene_path: Path | None = None,
         size: tuple[int, int] = (1280, 720),
         visible: bool = True,
+        trajectory: object = None,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -56,13 +57,16 @@ class Viewer:
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
         from .renderer import Renderer
+        from .screen import ScreenOverlay
 
         if world is None:
             from ballpit.scene import read_scene
 
             scene_path = Path(scene_path) if scene_path is not None else default_scene()
             world = read_scene(scene_path)
-        self.sim = Simulation(world, scene_path)
+        self.sim = Simulation(world, scene_path, trajectory=trajectory)
+        if trajectory is not None:
+            self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
         self.window = self._open_window(size, visible)
@@ -70,6 +74,7 @@ class Viewer:
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
+        self.screen = ScreenOverlay(self.window, self.sim)
         self.held: set[str] = set()
         self.mouse_captured = False
         self._quit_armed_until = 0.0  # a second Esc before this time quits
@@ -152,6 +157,10 @@ class Viewer:
             self.hud.show_help = not self.hud.show_help
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
+        elif action in controls.TIME_ACTIONS:
+            controls.TIME_ACTIONS[action](sim)
+        elif action is Action.ENERGY_PLOT:
+            self.screen.show_plot = not self.screen.show_plot
         self._hud_at = 0.0  # refresh the HUD on the next frame
 
     def escape(self) -> None:
@@ -194,7 +203,9 @@ class Viewer:
 
         name = key.symbol_string(symbol)
         self.held.add(name)
-        action = controls.action_for_key(name, ctrl=bool(modifiers & key.MOD_ACCEL))
+        action = controls.action_for_key(
+            name, ctrl=bool(modifiers & key.MOD_ACCEL), shift=bool(modifiers & key.MOD_SHIFT)
+        )
         if action is not None:
             self.perform(action)
         return True  # handled: stops pyglet's default "Esc closes the window"
@@ -214,9 +225,20 @@ class Viewer:
     def on_deactivate(self) -> None:
         self.held.clear()
 
+    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        if button == mouse.LEFT and self.screen.press(x, y):  # on the timeline bar: scrub
+            return
+
+    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        self.screen.release()
+
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        if buttons & mouse.LEFT and self.screen.drag(x, y):
+            return
         if buttons & mouse.RIGHT or self.mouse_captured:
             self.camera.look(dx, dy)
 
@@ -256,9 +278,11 @@ class Viewer:
 
         self.window.switch_to()
         self.feeder.upload(self.sim, self.flags, self.camera.position)
+        self.screen.upload(self.renderer)
         width, height = self.window.get_framebuffer_size()
         self.renderer.draw(self.camera, width, height, multisample=self.multisample)
         self._draw_hud(now)
+        self.screen.draw_labels()
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -272,6 +296,9 @@ class Viewer:
     def _draw_hud(self, now: float) -> None:
         from .hud import hud_lines, profile_lines
 
+        if self.hud.bottom != self.screen.bottom_clearance():
+            self.hud.bottom = self.screen.bottom_clearance()
+            self.hud.layout()
         if now >= self._hud_at:
             self._hud_at = now + HUD_INTERVAL
             if self.hud.page == "profile":
@@ -341,17 +368,18 @@ class Viewer:
         self._pyglet.app.run(FRAME_INTERVAL)
 
 
-def run(scene_path: Path | None = None) -> int:
+def run(scene_path: Path | None = None, trajectory: object = None) -> int:
     """Open the viewer on a scene file (the bundled slopes demo by default); returns the exit status.
 
-    With no display it prints one line saying how to render offscreen instead and returns 1.
+    With no display it prints one line saying how to render offscreen instead and returns 1. With a
+    ``trajectory`` (``replay.read_trajectory``) the window plays it instead of running the physics.
     """
     problem = backend.display_problem()
     if problem is not None:
         print(backend.no_display_message(problem), file=sys.stderr)
         return 1
     try:
-        viewer = Viewer(scene_path=scene_path)
+        viewer = Viewer(scene_path=scene_path, trajectory=trajectory)
     except Exception as exc:
         if _is_no_display(exc):
             print(backend.no_display_message(str(exc) or "cannot connect"), file=sys.stderr)

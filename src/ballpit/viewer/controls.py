@@ -10,8 +10,9 @@ and is built from the same bindings.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,11 @@ class Action(Enum):
     PROFILE = "HUD page: where the step's time goes"
     HELP = "show / hide this help"
     SCREENSHOT = "save a screenshot PNG"
+    STEP_BACK = "one step back through the history while paused"
+    JUMP_BACK = "a second back through the history while paused"
+    JUMP_FORWARD = "a second forward through the history while paused"
+    GHOSTS = "integrator ghosts and their energy drift"
+    ENERGY_PLOT = "live energy plot"
 
 
 KEY_ACTIONS: dict[str, Action] = {
@@ -62,9 +68,13 @@ KEY_ACTIONS: dict[str, Action] = {
     "F1": Action.HELP,
     "F2": Action.PROFILE,
     "F12": Action.SCREENSHOT,
+    "LEFT": Action.STEP_BACK,
+    "G": Action.GHOSTS,
+    "P": Action.ENERGY_PLOT,
 }
 
 CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
+SHIFT_KEY_ACTIONS: dict[str, Action] = {"LEFT": Action.JUMP_BACK, "RIGHT": Action.JUMP_FORWARD}
 
 # Typed text → action. "=" is the + key without Shift, "_" the − key with it.
 TEXT_ACTIONS: dict[str, Action] = {
@@ -104,6 +114,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("X", "start the drop (the scene waits until X)"),
     ("Space", "pause / resume"),
     ("N or →", "single step while paused"),
+    ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
     ("R", "reset to the initial state (then X drops again)"),
     ("Ctrl+R or F5", "reload the scene file (also on save)"),
     ("1 / 2 / 3", "integrator Euler / RK2 / RK4"),
@@ -112,17 +123,19 @@ HELP: tuple[tuple[str, str], ...] = (
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
     ("Esc", "release the mouse; Esc twice quits"),
-    ("C / V / T", "contacts and normals / velocity arrows / trails"),
+    ("C / V / T, G / P", "contacts, velocities, trails; ghosts, energy plot"),
     ("H / F1", "HUD / this help"),
     ("F2", "HUD page: time per stage of the step"),
     ("F12", "screenshot PNG into screenshots/"),
 )
 
 
-def action_for_key(name: str, ctrl: bool = False) -> Action | None:
+def action_for_key(name: str, ctrl: bool = False, shift: bool = False) -> Action | None:
     """The action bound to a key press, or None. ``name`` is pyglet's key symbol name."""
     if ctrl:
         return CTRL_KEY_ACTIONS.get(name)
+    if shift and name in SHIFT_KEY_ACTIONS:
+        return SHIFT_KEY_ACTIONS[name]
     return KEY_ACTIONS.get(name)
 
 
@@ -169,3 +182,12 @@ def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
     if mouse_captured:
         return "release"
     return "quit" if armed else "arm"
+
+
+# Moving in time and the ghosts: what each asks of the Simulation.
+TIME_ACTIONS: dict[Action, Callable[[Any], None]] = {
+    Action.STEP_BACK: lambda sim: sim.step_back(),
+    Action.JUMP_BACK: lambda sim: sim.jump(-1.0),
+    Action.JUMP_FORWARD: lambda sim: sim.jump(1.0),
+    Action.GHOSTS: lambda sim: sim.toggle_ghosts(),
+}

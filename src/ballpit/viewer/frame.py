@@ -49,6 +49,7 @@ class FrameFeeder:
         positions, orientations = sim.render_state()
         spheres = world.spheres
         self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors, eye)
+        self._upload_ghosts(sim)
 
         world_lines, overlay_lines = overlays.empty(), overlays.empty()
         if flags.trails and sim.trails.filled:
@@ -62,3 +63,20 @@ class FrameFeeder:
             overlay_lines = np.concatenate(parts)
         self.renderer.upload_lines(world_lines, overlay_lines)
         self.upload_seconds = time.perf_counter() - started
+
+    def _upload_ghosts(self, sim: Simulation) -> None:
+        """Every ghost world's balls, tinted by integrator, as one translucent instance set."""
+        from .ghosts import GHOST_ALPHA, TINTS
+
+        ghosts = sim.timeline.ghost_worlds()
+        if not ghosts:
+            self.renderer.upload_ghosts(np.zeros((0, 3)), np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3)))
+            return
+        spheres = [g.spheres for _, g in ghosts]
+        self.renderer.upload_ghosts(
+            np.concatenate([s.positions for s in spheres]),
+            np.concatenate([s.orientations for s in spheres]),
+            np.concatenate([s.radii for s in spheres]),
+            np.concatenate([np.broadcast_to(TINTS[name], (len(g.spheres), 3)) for name, g in ghosts]),
+            GHOST_ALPHA,
+        )

@@ -40,6 +40,7 @@ def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
         f"fly speed   {fly_speed:9.2f} m/s",
         f"overlays    {overlays or 'none'} (C V T)",
         f"state       {state}",
+        *timeline_lines(sim),
         "F1 help  F2 profile  H hide",
     ]
 
@@ -56,6 +57,24 @@ def profile_lines(sim: Simulation) -> list[str]:
         *p.lines(),
         "F2 back  H hide",
     ]
+
+
+def timeline_lines(sim: Simulation) -> list[str]:
+    """HUD lines for the history or replay and, with ghosts on, each integrator's energy drift."""
+    from .ghosts import LABELS
+
+    timeline = sim.timeline
+    lines = []
+    span = timeline.span()
+    if timeline.replay is not None:
+        lines.append(f"replay      {timeline.replay.trajectory.path.name}")
+    elif span is not None and timeline.history is not None and timeline.history.in_past:
+        lines.append(f"history     {span[2] - span[1]:.3f} s in the past (Space resumes from here)")
+    for name, drift, main in timeline.drifts():
+        what = "run  " if main else "ghost"
+        unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"
+        lines.append(f"E drift {what} {LABELS[name]:5s} {drift:+10.4f} {unit}")
+    return lines
 
 
 def help_text() -> str:
@@ -79,6 +98,7 @@ class Hud:
         self.message = ""
         self._message_until = 0.0
         self.help_hides_hud = False  # the window has no room for both: the help is drawn alone
+        self.bottom = 0  # pixels kept clear at the bottom (the timeline bar): messages go above them
         self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
         self.label = pyglet.text.Label(
@@ -104,9 +124,11 @@ class Hud:
         w, h = self.window.width, self.window.height
         self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
         self.error_label.width = max(w - 2 * MARGIN, 100)
-        self.error_label.x, self.error_label.y = MARGIN, MARGIN
+        self.error_label.x, self.error_label.y = MARGIN, MARGIN + self.bottom
         self.message_label.x = MARGIN
-        self.message_label.y = MARGIN + (self.error_label.content_height + 6 if self.error else 0)
+        self.message_label.y = (
+            MARGIN + self.bottom + (self.error_label.content_height + 6 if self.error else 0)
+        )
         self._fit_panel()
 
     def _fit_panel(self) -> None:

@@ -23,6 +23,8 @@ import numpy as np
 
 from ..physics.profile import RunProfile
 from ..scene import Appearance, Scene, read_scene, scene_of
+from .replay import Trajectory
+from .timeline import Timeline
 
 MAX_FRAME_SECONDS = 0.25
 TRAIL_POINT_BUDGET = 200_000  # trail samples kept over all balls
@@ -87,7 +89,9 @@ class Simulation:
         loader: Callable[[Path], Scene] | None = None,
         step_budget: float = 0.05,
         clock: Callable[[], float] = time.perf_counter,
+        trajectory: Trajectory | None = None,
     ) -> None:
+        self.trajectory = trajectory  # a replayed run (``view --replay``) instead of live physics
         self.loader = loader or read_scene
         self.step_budget = step_budget
         self.clock = clock
@@ -129,6 +133,23 @@ class Simulation:
         self._stats_sim = 0.0
         self.profile = RunProfile()  # the steps of the last stats window, stage by stage
         self._profile = RunProfile()
+        self._new_timeline()
+
+    def _new_timeline(self) -> None:
+        """History, replay, ghosts and energy trace start afresh (ghosts stay on if they were)."""
+        ghosts = getattr(self, "timeline", None) is not None and self.timeline.ghosts is not None
+        trajectory = self.trajectory
+        if trajectory is not None and trajectory.balls != self.ball_count:
+            self.error = (
+                f"{trajectory.path}: the trajectory has {trajectory.balls} balls, the scene {self.ball_count}"
+            )
+            trajectory = None
+        self.timeline = Timeline(self, trajectory)
+        if trajectory is not None:
+            self.after_seek(None)  # frame 0 of the replay is in the world now
+        if ghosts:
+            self.timeline.toggle_ghosts()
+        self.timeline.sample_energy()
 
     @property
     def timestep(self) -> float:
@@ -145,6 +166,7 @@ class Simulation:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self.message = "dropped"
+            self.timeline.started()
 
     def toggle_pause(self) -> None:
         """Space: pause a running simulation or resume a paused one."""
@@ -156,6 +178,8 @@ class Simulation:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self.message = "resumed"
+            if self.timeline.resumed():
+                self.message = "resumed from the past: the later history is dropped"
         else:
             self.message = "press X to start the drop"
 
@@ -163,6 +187,8 @@ class Simulation:
         """N / →: one fixed step, only while paused."""
         if self.phase is not Phase.PAUSED:
             self.message = "N steps only while paused (Space pauses)"
+            return
+        if self.timeline.forward() or self.timeline.replay is not None:
             return
         contacts = []
         self._step(contacts)
@@ -180,6 +206,10 @@ class Simulation:
     def set_integrator(self, name: str) -> None:
         self.world.integrator = name
         self.message = f"integrator {name.upper()}"
+        ghosts = self.timeline.ghosts
+        if ghosts is not None and name in ghosts.integrators:  # the ghosts become the other two again
+            self.timeline.toggle_ghosts()
+            self.message += "; " + self.timeline.toggle_ghosts()
 
     def faster(self) -> None:
         from .controls import faster
@@ -246,6 +276,8 @@ class Simulation:
                 steps += 1
             self._finish_steps(contacts)
             self.alpha = min(self.accumulator / dt, 1.0) if self.phase is Phase.RUNNING else 1.0
+        if steps:
+            self.timeline.sample_energy()
         self._update_stats(frame_seconds, steps)
         return steps
 
@@ -254,7 +286,7 @@ class Simulation:
         self.prev_positions[:] = spheres.positions
         self.prev_orientations[:] = spheres.orientations
         try:
-            result = self.world.step(self.timestep)
+            result = self.timeline.step(self.timestep)
         except Exception as exc:  # a physics failure pauses the viewer instead of killing it
             self.phase = Phase.PAUSED
             self.error = f"physics step failed: {_describe(exc)}"
@@ -267,6 +299,50 @@ class Simulation:
         self._stats_steps += 1
         self._stats_sim += self.timestep
         self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+
+    # ------------------------------------------------------------------ history, replay, ghosts
+    def step_back(self) -> None:
+        """←: one step back through the history, only while paused."""
+        self._move(lambda t: t.back(), "← steps back only while paused (Space pauses)")
+
+    def jump(self, seconds: float) -> None:
+        """Shift+← / Shift+→: a second back or forward through the history, only while paused."""
+        self._move(lambda t: t.jump(seconds), "Shift+←/→ jump only while paused (Space pauses)")
+
+    def scrub(self, fraction: float) -> None:
+        """Dragging on the timeline bar: pause and go to that point of the span kept (0 oldest, 1 newest)."""
+        if self.phase is Phase.RUNNING:
+            self.toggle_pause()
+        self._move(lambda t: t.scrub(fraction), "")
+
+    def _move(self, how: Callable[[Timeline], bool], refusal: str) -> None:
+        if self.phase is not Phase.PAUSED:
+            self.message = refusal if self.phase is Phase.RUNNING else "press X to start the drop"
+            return
+        if not how(self.timeline):
+            self.message = "no history yet"
+
+    def after_seek(self, contacts: object) -> None:
+        """The timeline moved the world: draw it as it is now, with no interpolation or old trails."""
+        spheres = self.world.spheres
+        self.prev_positions = np.array(spheres.positions, dtype=float)
+        self.prev_orientations = np.array(spheres.orientations, dtype=float)
+        self.alpha = 1.0
+        self.contacts = contacts
+        self.last_step_contacts = len(contacts) if contacts is not None else 0
+        self.trails = Trails(len(spheres))
+        self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+        self.timeline.sample_energy()
+
+    def end_of_replay(self) -> None:
+        """The replay showed its last frame: pause there."""
+        self.phase = Phase.PAUSED
+        self.message = "end of the replay: ← / drag the timeline to go back, R restarts"
+
+    def toggle_ghosts(self) -> None:
+        """G: integrator ghosts on or off."""
+        self.message = self.timeline.toggle_ghosts()
+        self.timeline.sample_energy()
 
     def _finish_steps(self, contacts: list) -> None:
         if contacts:
