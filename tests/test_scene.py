@@ -287,3 +287,16 @@ def test_resolve_scene_path_finds_bundled_scenes_by_name(tmp_path):
     assert resolve_scene_path("slopes").name == "slopes.toml"
     assert resolve_scene_path("slopes.toml").is_file()
     assert resolve_scene_path(tmp_path / "missing.toml") == tmp_path / "missing.toml"
+
+
+def test_a_plane_moves_as_its_scene_table_says(tmp_path):
+    world = load_scene(
+        write(tmp_path, "[[plane]]\nsize = 2\nvelocity = [0, 1, 0]\nangular_velocity = [0, 0, 0.5]\n")
+    )
+    plane = world.planes[0]
+    assert plane.velocity == pytest.approx((0, 1, 0)) and plane.angular_velocity == pytest.approx((0, 0, 0.5))
+    world.step(0.5)
+    assert plane.position == pytest.approx((0, 0.5, 0))
+    assert plane.normal == pytest.approx((-np.sin(0.25), np.cos(0.25), 0))  # turned 0.25 rad about z
+    error = load_error(tmp_path, "[[plane]]\nangular_velocity = [0, 'fast', 0]\n")
+    assert "angular_velocity" in str(error) and "plane #1" in str(error)

@@ -173,6 +173,8 @@ class Builder:
             restitution=e.number("restitution", d["restitution"], nonnegative=True),
             friction=e.number("friction", d["friction"], nonnegative=True),
             rolling_friction=e.number("rolling_friction", d["rolling_friction"], nonnegative=True),
+            velocity=e.vector("velocity", d["velocity"]),
+            angular_velocity=e.vector("angular_velocity", d["angular_velocity"]),
         )
         return e, kwargs, e.color("color")
 

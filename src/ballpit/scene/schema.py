@@ -28,7 +28,18 @@ TIMESTEP_DEFAULT = DEFAULT_TIMESTEP  # s per physics step, when [world] gives no
 INTEGRATORS = INTEGRATOR_NAMES
 # What [[plane]] passes to World.add_plane.
 PLANE_DEFAULTS = _defaults(
-    World.add_plane, ("position", "rotation", "normal", "size", "restitution", "friction", "rolling_friction")
+    World.add_plane,
+    (
+        "position",
+        "rotation",
+        "normal",
+        "size",
+        "restitution",
+        "friction",
+        "rolling_friction",
+        "velocity",
+        "angular_velocity",
+    ),
 )
 # What every ball ([[sphere]] or a [[grid]]'s balls) passes to World.add_sphere besides its position.
 BALL_DEFAULTS = _defaults(
