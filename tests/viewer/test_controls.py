@@ -108,3 +108,15 @@ def test_help_lists_every_control_of_the_design_table():
                   "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12"):  # fmt: skip
         assert label in keys, label
     assert "scroll" in " ".join(w for _, w in controls.HELP)
+
+
+def test_reaching_in_keys_shoot_change_the_shot_speed_go_home_and_save():
+    assert action_for_key("B") is Action.SHOOT
+    assert action_for_key("B", shift=True) is Action.SHOT_SPEED
+    assert action_for_key("HOME") is Action.HOME
+    assert action_for_key("S", ctrl=True) is Action.SAVE
+    assert action_for_key("S") is None and "S" in controls.FLY_KEYS  # plain S still flies back
+    assert action_for_key("X", shift=True) is Action.START  # Shift changes only what it is bound for
+    keys = " ".join(k for k, _ in controls.HELP)
+    for label in ("left-drag", "B / Shift+B", "click a plane", "Home", "Ctrl+S"):
+        assert label in keys, label

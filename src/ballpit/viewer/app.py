@@ -54,6 +54,7 @@ class Viewer:
         from .camera import Camera
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
+        from .interaction import Interaction
         from .renderer import Renderer
 
         if world is None:
@@ -62,6 +63,7 @@ class Viewer:
             scene_path = Path(scene_path) if scene_path is not None else default_scene()
             world = ballpit.load_scene(scene_path)
         self.sim = Simulation(world, scene_path)
+        self.interaction = Interaction(self.sim)
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
         self.window = self._open_window(size, visible)
@@ -76,6 +78,7 @@ class Viewer:
         self._window_closed = False
         self.screenshot_requested = False
         self.last_screenshot: Path | None = None
+        self.last_save: Path | None = None
         self.physics_seconds = 0.0
         self.fps = 0.0
         self.frames = 0
@@ -148,12 +151,23 @@ class Viewer:
             self.hud.show_help = not self.hud.show_help
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
+        elif action is Action.SHOOT:
+            self.interaction.shoot(self.camera)
+        elif action is Action.SHOT_SPEED:
+            sim.message = f"shot speed {self.interaction.next_shot_speed():g} m/s"
+        elif action is Action.HOME:
+            self.camera.look_from(sim.appearance.camera_position, sim.appearance.camera_look_at)
+        elif action is Action.SAVE:
+            self.save_scene()
         self._hud_at = 0.0  # refresh the HUD on the next frame
 
     def escape(self) -> None:
         """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
         until then the HUD asks for it."""
         now = time.perf_counter()
+        if not self.mouse_captured and self.interaction.deselect():
+            self.hud.flash("plane deselected", now)
+            return
         outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
         if outcome == "quit":
             self.close()
@@ -167,6 +181,22 @@ class Viewer:
         ok = self.sim.reload()
         self.hud.set_error(self.sim.error)
         return ok
+
+    def save_scene(self) -> Path | None:
+        """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
+        from .save import save_scene
+
+        try:
+            self.last_save = save_scene(self.sim, self.camera, self.interaction.own_motion())
+        except OSError as exc:
+            self.hud.flash(f"save failed: {exc}", time.perf_counter())
+            return None
+        shown = self.last_save
+        if shown.is_relative_to(Path.cwd()):
+            shown = shown.relative_to(Path.cwd())
+        print(f"scene saved to {self.last_save}", flush=True)
+        self.hud.flash(f"scene saved to {shown}", time.perf_counter())
+        return self.last_save
 
     def capture_mouse(self, captured: bool) -> None:
         self.mouse_captured = captured
@@ -189,8 +219,12 @@ class Viewer:
         from pyglet.window import key
 
         name = key.symbol_string(symbol)
-        self.held.add(name)
-        action = controls.action_for_key(name, ctrl=bool(modifiers & key.MOD_ACCEL))
+        ctrl = bool(modifiers & key.MOD_ACCEL)
+        if not (ctrl and name in controls.FLY_KEYS):  # Ctrl+S saves; it does not fly back
+            self.held.add(name)
+        if self.interaction.takes_key(name):  # arrows and PgUp/PgDn move a selected plane while held
+            return True
+        action = controls.action_for_key(name, ctrl=ctrl, shift=bool(modifiers & key.MOD_SHIFT))
         if action is not None:
             self.perform(action)
         return True  # handled: stops pyglet's default "Esc closes the window"
@@ -210,9 +244,26 @@ class Viewer:
     def on_deactivate(self) -> None:
         self.held.clear()
 
+    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        from .picking import pointer_ray
+
+        if button == mouse.LEFT and not self.mouse_captured:
+            ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
+            self.sim.message = self.interaction.press(ray, x, y, self.camera.forward) or self.sim.message
+
+    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        if button == mouse.LEFT:
+            self.interaction.release()
+
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        if buttons & mouse.LEFT:
+            self.interaction.move(x, y)
         if buttons & mouse.RIGHT or self.mouse_captured:
             self.camera.look(dx, dy)
 
@@ -242,6 +293,8 @@ class Viewer:
             controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
         )
 
+        size = (self.window.width, self.window.height)
+        self.interaction.update(self.camera, size, self.held, elapsed)
         started = time.perf_counter()
         self.sim.advance(elapsed)
         self.physics_seconds = time.perf_counter() - started
@@ -251,7 +304,9 @@ class Viewer:
                 self.reload()
 
         self.window.switch_to()
-        self.feeder.upload(self.sim, self.flags, self.camera.position)
+        selected = self.interaction.selected_plane
+        self.renderer.selected_plane = -1 if selected is None else selected
+        self.feeder.upload(self.sim, self.flags, self.camera.position, self.interaction.lines())
         width, height = self.window.get_framebuffer_size()
         self.renderer.draw(self.camera, width, height, multisample=self.multisample)
         self._draw_hud(now)
@@ -270,7 +325,9 @@ class Viewer:
 
         if now >= self._hud_at:
             self._hud_at = now + HUD_INTERVAL
-            self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names()))
+            extra = self.interaction.hud_lines()
+            shot = self.interaction.shot_speed
+            self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names(), extra, shot))
             self.hud.set_error(self.sim.error)
         if self.sim.message != self._shown_message:
             self._shown_message = self.sim.message
