@@ -72,6 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("view", help="open the viewer on SCENE (default: the bundled slopes demo)")
     p.add_argument("scene", nargs="?", help="a scene file, or a bundled scene's name")
+    p.add_argument("--record", type=Path, metavar="FILE", help="when the window closes, write every step "
+                   "it showed to FILE (.npz or .csv, simulate's trajectory columns)")  # fmt: skip
     p.set_defaults(handler=_view)
 
     p = sub.add_parser("check", help="validate a scene file")
@@ -214,7 +216,10 @@ def _simulate(args: argparse.Namespace) -> int:
 
 def _view(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
+    from .writers import check_output_path
 
+    if args.record is not None:
+        check_output_path(args.record, "--record")  # a bad path is a one-line error before a window opens
     path = None
     if args.scene is not None:
         path = resolve_scene_path(args.scene)
@@ -227,7 +232,7 @@ def _view(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_FAILED
-    return int(run(path) or EXIT_OK)
+    return int(run(path, record=args.record) or EXIT_OK)
 
 
 def _render(args: argparse.Namespace) -> int:

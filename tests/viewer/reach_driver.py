@@ -9,6 +9,7 @@ key events from xdotool; the window, GL context, shaders and physics are all rea
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -341,8 +342,28 @@ def save(workdir: Path) -> dict:
     return out
 
 
+def record_close_button(workdir: Path) -> dict:
+    """--record: drop, reset, drop again, then the window's close button (pyglet's on_close)."""
+    path = workdir / "live.toml"
+    path.write_text(RAMP_SCENE)
+    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz")
+    viewer.sim.step_budget = math.inf
+    press(viewer, "X", frames=20)
+    press(viewer, "R", frames=2)
+    press(viewer, "X", frames=25)
+    out = {
+        "steps_since_reset": viewer.sim.steps_total,
+        "written_before_close": (workdir / "run.npz").exists(),
+    }
+    viewer.window.dispatch_event("on_close")
+    viewer.pump()
+    out["closed"] = viewer.closed
+    return out
+
+
 SCENARIOS = {
-    f.__name__: f for f in (drag_throw, drag_throw_paused, shoot, plane_tilt, plane_lift, home, save)
+    f.__name__: f
+    for f in (drag_throw, drag_throw_paused, shoot, plane_tilt, plane_lift, home, save, record_close_button)
 }
 
 

@@ -47,6 +47,7 @@ class Viewer:
         scene_path: Path | None = None,
         size: tuple[int, int] = (1280, 720),
         visible: bool = True,
+        record: Path | None = None,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -64,6 +65,11 @@ class Viewer:
             world = ballpit.load_scene(scene_path)
         self.sim = Simulation(world, scene_path)
         self.interaction = Interaction(self.sim)
+        self.recorder = None
+        if record is not None:
+            from .recording import Recorder
+
+            self.recorder = Recorder(record, self.sim)
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
         self.window = self._open_window(size, visible)
@@ -210,9 +216,16 @@ class Viewer:
             self._close_window()
 
     def _close_window(self) -> None:
+        self.finish_record()
         if not self._window_closed:
             self._window_closed = True
             self.window.close()
+
+    def finish_record(self) -> None:
+        """Write the ``--record`` file (once), when the window closes or the run is interrupted."""
+        if self.recorder is not None and not self.recorder.finished:
+            steps, path = self.recorder.steps, self.recorder.finish()
+            print(f"recorded {steps} steps ({self.sim.ball_count} balls) to {path}", flush=True)
 
     # ------------------------------------------------------------------ pyglet events
     def on_key_press(self, symbol: int, modifiers: int) -> bool:
@@ -279,6 +292,7 @@ class Viewer:
 
     def on_close(self) -> None:
         self.closed = True
+        self.finish_record()
 
     def on_draw(self) -> None:
         self.frame()
@@ -391,8 +405,9 @@ class Viewer:
         self._pyglet.app.run(FRAME_INTERVAL)
 
 
-def run(scene_path: Path | None = None) -> int:
+def run(scene_path: Path | None = None, record: Path | None = None) -> int:
     """Open the viewer on a scene file (the bundled slopes demo by default); returns the exit status.
+    With ``record``, the timeline it showed is written there when the window closes (or on Ctrl+C).
 
     With no display it prints one line saying how to render offscreen instead and returns 1.
     """
@@ -401,11 +416,14 @@ def run(scene_path: Path | None = None) -> int:
         print(backend.no_display_message(problem), file=sys.stderr)
         return 1
     try:
-        viewer = Viewer(scene_path=scene_path)
+        viewer = Viewer(scene_path=scene_path, record=record)
     except Exception as exc:
         if _is_no_display(exc):
             print(backend.no_display_message(str(exc) or "cannot connect"), file=sys.stderr)
             return 1
         raise
-    viewer.run()
+    try:
+        viewer.run()
+    finally:
+        viewer.finish_record()
     return 0
