@@ -226,5 +226,5 @@ class Interaction:
             speed = float(np.linalg.norm(self.throw_velocity()))
             lines.append(f"holding     ball {self.held_ball}, throw {speed:.2f} m/s")
         if self.selected_plane is not None:
-            lines.append(f"selected    plane #{self.selected_plane + 1} (arrows PgUp PgDn, Esc)")
+            lines.append(f"selected    plane #{self.selected_plane + 1}: arrows PgUp PgDn")
         return lines
