@@ -134,6 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="play a trajectory (.npz or .csv) written by 'simulate --out' or '--record'; "
         "the scene gives the planes, radii and colours",
     )
+    p.add_argument("--record", type=Path, metavar="FILE", help="when the window closes, write every step "
+                   "it showed to FILE (.npz or .csv, simulate's trajectory columns)")  # fmt: skip
     p.set_defaults(handler=_view)
 
     p = sub.add_parser("check", help="validate a scene file")
@@ -363,16 +365,21 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _view(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
+    from .writers import check_output_path
 
+    if args.record is not None:
+        check_output_path(args.record, "--record")  # a bad path is a one-line error before a window opens
+    if args.record is not None and args.replay is not None:
+        raise UsageError("--record and --replay cannot be used together")
     path = world = None
     if args.scene is not None:
         path = resolve_scene_path(args.scene)
-        world = _load(str(path))  # a bad scene gets its one-line error before a window opens
+        world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
     trajectory = None
     if args.replay is not None:
         from .viewer.replay import TrajectoryError, read_trajectory
 
-        world = world if world is not None else _load("slopes")
+        world = world if world is not None else _load("slopes").world
         try:
             trajectory = read_trajectory(args.replay, n_balls=len(world.spheres))
         except TrajectoryError as e:
@@ -386,7 +393,7 @@ def _view(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_FAILED
-    return int(run(path, trajectory=trajectory) or EXIT_OK)
+    return int(run(path, trajectory=trajectory, record=args.record) or EXIT_OK)
 
 
 def _render(args: argparse.Namespace) -> int:

@@ -220,29 +220,36 @@ class TrajectoryWriter(_SpooledOutput):
     """Every ball's state at the recorded times: one row per ball per record.
 
     ``record`` copies the state into a preallocated buffer; full buffers go to disk as CSV text, or
-    to the ``.npz``'s column spool.
+    to the ``.npz``'s column spool. The number of balls may change between records (the viewer adds
+    balls): ball ``i`` is always id ``i``, and new balls get the next ids.
     """
 
     types = _TRAJECTORY_TYPES
 
-    def __init__(self, path: Path, n_balls: int) -> None:
+    def __init__(self, path: Path, n_balls: int, option: str = "--out") -> None:
         self.path = path
-        self.format = check_output_path(path, "--out")
-        self.n = n_balls
+        self.format = check_output_path(path, option)
         self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.out = AtomicFile(
             path, "w" if self.format == ".csv" else "wb"
         )  # after the spool: its error leaves nothing
-        self.records_per_chunk = max(1, _CHUNK_ROWS // max(1, n_balls))
-        self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
-        self.buffer[:, :, 1] = np.arange(n_balls)
-        self.filled = 0
+        self._allocate(n_balls)
         self.records = 0
         self.row_format = ",".join(["%.9g", "%d"] + [_FLOAT] * (len(TRAJECTORY_COLUMNS) - 2)) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(TRAJECTORY_COLUMNS) + "\n")
 
+    def _allocate(self, n_balls: int) -> None:
+        self.n = n_balls
+        self.records_per_chunk = max(1, _CHUNK_ROWS // max(1, n_balls))
+        self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
+        self.buffer[:, :, 1] = np.arange(n_balls)
+        self.filled = 0
+
     def record(self, time: float, position, velocity, angular_velocity, orientation) -> None:
+        if len(position) != self.n:  # balls were added: rows of the new count from here on
+            self._flush()
+            self._allocate(len(position))
         row = self.buffer[self.filled]
         row[:, 0] = time
         row[:, 2:5] = position

@@ -44,6 +44,10 @@ class Action(Enum):
     JUMP_FORWARD = "a second forward through the history while paused"
     GHOSTS = "integrator ghosts and their energy drift"
     ENERGY_PLOT = "live energy plot"
+    SHOOT = "shoot a ball along the view"
+    SHOT_SPEED = "change the shot speed"
+    HOME = "camera back to the scene's view"
+    SAVE = "save the scene as it stands to a new file"
 
 
 KEY_ACTIONS: dict[str, Action] = {
@@ -71,10 +75,16 @@ KEY_ACTIONS: dict[str, Action] = {
     "LEFT": Action.STEP_BACK,
     "G": Action.GHOSTS,
     "P": Action.ENERGY_PLOT,
+    "B": Action.SHOOT,
+    "HOME": Action.HOME,
 }
 
-CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
-SHIFT_KEY_ACTIONS: dict[str, Action] = {"LEFT": Action.JUMP_BACK, "RIGHT": Action.JUMP_FORWARD}
+CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD, "S": Action.SAVE}
+SHIFT_KEY_ACTIONS: dict[str, Action] = {
+    "LEFT": Action.JUMP_BACK,
+    "RIGHT": Action.JUMP_FORWARD,
+    "B": Action.SHOT_SPEED,
+}
 
 # Typed text → action. "=" is the + key without Shift, "_" the − key with it.
 TEXT_ACTIONS: dict[str, Action] = {
@@ -111,22 +121,22 @@ QUIT_HINT = "press Esc again to quit"
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
 
 HELP: tuple[tuple[str, str], ...] = (
-    ("X", "start the drop (the scene waits until X)"),
-    ("Space", "pause / resume"),
+    ("X / Space", "start the drop (it waits for X) / pause"),
     ("N or →", "single step while paused"),
     ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
-    ("R", "reset to the initial state (then X drops again)"),
-    ("Ctrl+R or F5", "reload the scene file (also on save)"),
-    ("1 / 2 / 3", "integrator Euler / RK2 / RK4"),
-    ("+ / −", "faster / slower time"),
+    ("R / Ctrl+R or F5", "reset (X drops again) / reload (also on save)"),
+    ("1 / 2 / 3, + / −", "Euler / RK2 / RK4; faster / slower time"),
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
-    ("Esc", "release the mouse; Esc twice quits"),
+    ("Esc", "release the mouse, drop a plane; twice quits"),
     ("C / V / T, G / P", "contacts, velocities, trails; ghosts, energy plot"),
-    ("H / F1", "HUD / this help"),
-    ("F2", "HUD page: time per stage of the step"),
-    ("F12", "screenshot PNG into screenshots/"),
+    ("H / F1 / F2", "HUD / this help / HUD page: time per stage"),
+    ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
+    ("left-drag a ball", "pick it up and move it; let go to throw it"),
+    ("B / Shift+B", "shoot a ball along the view / its speed"),
+    ("click a plane", "select it: arrows tilt it, PgUp/PgDn lift it"),
+    ("Home", "camera back to the scene's view"),
 )
 
 

@@ -29,23 +29,29 @@ class FrameFeeder:
         self.renderer = renderer
         self._generation: int | None = None
         self._sim: Simulation | None = None
+        self._plane_pose = np.zeros((0, 7))
         self.upload_seconds = 0.0
 
     def upload(
-        self, sim: Simulation, flags: OverlayFlags | None = None, eye: np.ndarray | None = None
+        self,
+        sim: Simulation,
+        flags: OverlayFlags | None = None,
+        eye: np.ndarray | None = None,
+        extra_lines: np.ndarray | None = None,
     ) -> None:
-        """Upload this frame's balls (sorted nearest first when ``eye`` is given), lines and, when the
-        scene changed, planes."""
+        """Upload this frame's balls (sorted nearest first when ``eye`` is given), lines (``extra_lines``
+        are drawn on top, like the overlays) and the planes when the scene changed or they moved."""
         started = time.perf_counter()
         flags = flags or OverlayFlags()
         look = sim.appearance
         world = sim.world
-        if sim is not self._sim or sim.generation != self._generation:
+        centers, plane_orientations = sim.render_planes()
+        pose = np.hstack([centers, plane_orientations])
+        changed = sim is not self._sim or sim.generation != self._generation
+        if changed or pose.shape != self._plane_pose.shape or not np.array_equal(pose, self._plane_pose):
             planes = world.planes
-            self.renderer.set_planes(
-                planes.centers, planes.orientations, planes.half_sizes, look.plane_colors
-            )
-            self._sim, self._generation = sim, sim.generation
+            self.renderer.set_planes(centers, plane_orientations, planes.half_sizes, look.plane_colors)
+            self._sim, self._generation, self._plane_pose = sim, sim.generation, pose
         positions, orientations = sim.render_state()
         spheres = world.spheres
         self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors, eye)
@@ -59,6 +65,8 @@ class FrameFeeder:
             parts.append(overlays.contact_lines(sim.contacts.point, sim.contacts.normal))
         if flags.velocities:
             parts.append(overlays.velocity_arrows(positions, np.asarray(spheres.velocities)))
+        if extra_lines is not None and len(extra_lines):
+            parts.append(extra_lines)
         if parts:
             overlay_lines = np.concatenate(parts)
         self.renderer.upload_lines(world_lines, overlay_lines)

@@ -8,6 +8,8 @@ small for both shows the help alone).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pyglet
 
 from .controls import HELP
@@ -22,8 +24,15 @@ MARGIN = 10
 MESSAGE_SECONDS = 3.0
 
 
-def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
-    """The HUD's text: time, speed, integrator, step rate, counts, energy and the run state."""
+def hud_lines(
+    sim: Simulation,
+    fly_speed: float,
+    overlays: str,
+    extra: Sequence[str] = (),
+    shot_speed: float | None = None,
+) -> list[str]:
+    """The HUD's text: time, speed, integrator, step rate, counts, energy, fly (and shot) speed,
+    ``extra`` lines and the run state."""
     world = sim.world
     state = sim.phase.value
     if sim.phase is Phase.RUNNING and sim.time_scale != 1.0:
@@ -37,8 +46,9 @@ def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
         f"balls       {sim.ball_count:9d}",
         f"contacts    {sim.last_step_contacts:9d}",
         f"kinetic E   {sim.kinetic_energy():9.3f} J",
-        f"fly speed   {fly_speed:9.2f} m/s",
+        f"fly speed   {fly_speed:9.2f} m/s" + ("" if shot_speed is None else f"  shot {shot_speed:g} m/s"),
         f"overlays    {overlays or 'none'} (C V T)",
+        *extra,
         f"state       {state}",
         *timeline_lines(sim),
         "F1 help  F2 profile  H hide",

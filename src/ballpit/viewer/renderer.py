@@ -132,6 +132,7 @@ class Renderer:
         for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10)]):
             _attribute(index, size, PLANE_STRIDE, offset)
         self.plane_vertices = 0
+        self.selected_plane = -1  # drawn with a highlighted rim (or tint, if infinite); -1: none
         self._plane_centers = np.zeros((0, 3))
         self._plane_normals = np.zeros((0, 3))
 
@@ -268,6 +269,8 @@ class Renderer:
         program.set("u_eye", eye)
         program.set("u_background", self.background)
         program.set("u_fog_density", self.fog_density)
+        if program is self.plane_program:
+            program.set("u_selected", int(self.selected_plane))
 
     def seen_from_behind(self, eye: np.ndarray) -> np.ndarray:
         """Which planes have the eye on their back side (drawn see-through), as a bool array."""

@@ -69,6 +69,11 @@ class Trails:
         self.filled = min(self.filled + 1, self.length)
         self.last_time = sim_time
 
+    def grow(self, position: np.ndarray) -> None:
+        """Make room for one more ball, whose trail starts where it is now."""
+        extra = np.broadcast_to(np.asarray(position, dtype=np.float32), (self.length, 1, 3))
+        self._samples = np.concatenate([self._samples, extra], axis=1)
+
     def ordered(self) -> np.ndarray:
         """(filled, N, 3) samples, oldest first."""
         order = (self._head - self.filled + np.arange(self.filled)) % self.length
@@ -100,6 +105,11 @@ class Simulation:
         self.message: str = ""
         self.generation = 0  # bumps whenever the world is replaced, so the renderer rebuilds geometry
         self.dropped_seconds = 0.0  # simulated time skipped because physics could not keep up
+        # Hooks (no arguments): before and after every physics step, and whenever the run restarts
+        # (a new world, a reset or a reload). Reaching in and recording attach here.
+        self.before_step: list[Callable[[], None]] = []
+        self.after_step: list[Callable[[], None]] = []
+        self.after_reset: list[Callable[[], None]] = []
         self._install(scene_of(world, path))
 
     # ------------------------------------------------------------------ world management
@@ -116,11 +126,14 @@ class Simulation:
 
     def _reset_dynamics(self) -> None:
         spheres = self.world.spheres
+        self.appearance.sphere_colors = self.appearance.sphere_colors[: len(spheres)]  # drop added balls
         self.phase = Phase.WAITING
         self.accumulator = 0.0
         self.alpha = 1.0
         self.prev_positions = np.array(spheres.positions, dtype=float)
         self.prev_orientations = np.array(spheres.orientations, dtype=float)
+        self.prev_plane_centers = np.array(self.world.planes.centers, dtype=float)
+        self.prev_plane_orientations = np.array(self.world.planes.orientations, dtype=float)
         self.contacts = None  # Contacts of the last frame that stepped
         self.last_step_contacts = 0
         self.trails = Trails(len(spheres))
@@ -134,6 +147,8 @@ class Simulation:
         self.profile = RunProfile()  # the steps of the last stats window, stage by stage
         self._profile = RunProfile()
         self._new_timeline()
+        for hook in self.after_reset:
+            hook()
 
     def _new_timeline(self) -> None:
         """History, replay, ghosts and energy trace start afresh (ghosts stay on if they were)."""
@@ -282,9 +297,13 @@ class Simulation:
         return steps
 
     def _step(self, contacts: list) -> None:
-        spheres = self.world.spheres
+        for hook in self.before_step:
+            hook()
+        spheres, planes = self.world.spheres, self.world.planes
         self.prev_positions[:] = spheres.positions
         self.prev_orientations[:] = spheres.orientations
+        self.prev_plane_centers[:] = planes.centers
+        self.prev_plane_orientations[:] = planes.orientations
         try:
             result = self.timeline.step(self.timestep)
         except Exception as exc:  # a physics failure pauses the viewer instead of killing it
@@ -299,6 +318,19 @@ class Simulation:
         self._stats_steps += 1
         self._stats_sim += self.timestep
         self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+        for hook in self.after_step:
+            hook()
+
+    def add_ball(self, color: object, **kwargs: object) -> int:
+        """Add a ball to the live world (``World.add_sphere`` arguments) drawn in ``color``; returns its
+        index. Everything kept per ball (colours, trails, interpolation) grows with it."""
+        ball = self.world.add_sphere(**kwargs)
+        look = self.appearance
+        look.sphere_colors = np.vstack([look.sphere_colors, np.asarray(color, dtype=float).reshape(1, 3)])
+        self.prev_positions = np.vstack([self.prev_positions, ball.position])
+        self.prev_orientations = np.vstack([self.prev_orientations, ball.orientation])
+        self.trails.grow(np.asarray(ball.position, dtype=np.float32))
+        return ball.index
 
     # ------------------------------------------------------------------ history, replay, ghosts
     def step_back(self) -> None:
@@ -377,6 +409,20 @@ class Simulation:
         q = prev_q * (1.0 - a) + quat * sign * a
         q /= np.linalg.norm(q, axis=1, keepdims=True)
         return positions, q
+
+    def render_planes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Plane centres (P, 3) and orientations (P, 4) at the same ``alpha`` as ``render_state``."""
+        planes = self.world.planes
+        pos = np.asarray(planes.centers, dtype=float)
+        quat = np.asarray(planes.orientations, dtype=float)
+        a = self.alpha
+        if a >= 1.0 or self.phase is not Phase.RUNNING:
+            return pos, quat
+        prev_q = self.prev_plane_orientations
+        sign = np.where(np.einsum("ij,ij->i", prev_q, quat) < 0.0, -1.0, 1.0)[:, None]
+        q = prev_q * (1.0 - a) + quat * sign * a
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        return self.prev_plane_centers + (pos - self.prev_plane_centers) * a, q
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of all balls, J (the physics' own measure)."""
