@@ -144,6 +144,16 @@ class ColumnSpool:
         self.file.write(np.ascontiguousarray(rows.T, dtype=np.float64).data)  # a full disk: ENOSPC
         self.rows += len(rows)
 
+    def truncate(self, chunks: int) -> None:
+        """Keep only the first ``chunks`` chunks (the rest of the scratch file is cut off)."""
+        if chunks >= len(self.chunks):
+            return
+        offset = self.chunks[chunks][0]
+        self.rows -= sum(rows for _, rows in self.chunks[chunks:])
+        del self.chunks[chunks:]
+        self.file.truncate(offset)
+        self.file.seek(offset)
+
     def column(self, k: int):
         """Column ``k``, one chunk at a time."""
         for offset, rows in self.chunks:
@@ -226,9 +236,13 @@ class TrajectoryWriter(_SpooledOutput):
 
     types = _TRAJECTORY_TYPES
 
-    def __init__(self, path: Path, n_balls: int, option: str = "--out") -> None:
+    def __init__(
+        self, path: Path, n_balls: int, option: str = "--out", records_per_chunk: int | None = None
+    ) -> None:
         self.path = path
         self.format = check_output_path(path, option)
+        self.chunk_records = records_per_chunk  # 1: every record is its own chunk, so it can be cut off
+        self._marks: list[int] = []  # where each chunk begins: a byte offset (.csv) or spool chunk (.npz)
         self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.out = AtomicFile(
             path, "w" if self.format == ".csv" else "wb"
@@ -241,7 +255,7 @@ class TrajectoryWriter(_SpooledOutput):
 
     def _allocate(self, n_balls: int) -> None:
         self.n = n_balls
-        self.records_per_chunk = max(1, _CHUNK_ROWS // max(1, n_balls))
+        self.records_per_chunk = self.chunk_records or max(1, _CHUNK_ROWS // max(1, n_balls))
         self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
         self.buffer[:, :, 1] = np.arange(n_balls)
         self.filled = 0
@@ -262,13 +276,38 @@ class TrajectoryWriter(_SpooledOutput):
             self._flush()
 
     def _flush(self) -> None:
+        if self.filled == 0:
+            return
         rows = self.buffer[: self.filled].reshape(-1, len(TRAJECTORY_COLUMNS))
         with _writing(self.path):
             if self.spool is None:
+                self._marks.append(self.out.file.tell())
                 self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
             else:
+                self._marks.append(len(self.spool.chunks))
                 self.spool.add(rows)
         self.filled = 0
+
+    def truncate(self, records: int) -> None:
+        """Keep only the first ``records`` records (the viewer resuming from the past drops its future).
+        Records already written can be cut off only when each is its own chunk (``records_per_chunk=1``)."""
+        if records >= self.records:
+            return
+        written = self.records - self.filled
+        if records >= written:  # still in the buffer
+            self.filled = records - written
+        else:
+            if self.chunk_records != 1:
+                raise ValueError("records already written can be cut off only with records_per_chunk=1")
+            self._flush()
+            mark = self._marks[records]
+            del self._marks[records:]
+            if self.spool is None:
+                self.out.file.truncate(mark)
+                self.out.file.seek(mark)
+            else:
+                self.spool.truncate(mark)
+        self.records = records
 
 
 class EventWriter(_SpooledOutput):

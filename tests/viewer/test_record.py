@@ -14,8 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ballpit
-from ballpit.scene import default_scene_path
+from ballpit.scene import default_scene_path, read_scene
 from ballpit.writers import TRAJECTORY_COLUMNS
 
 from .conftest import subprocess_env
@@ -59,7 +58,7 @@ def finish(proc: subprocess.Popen) -> tuple[str, str]:
 
 def simulate(scene: Path, steps: int, out: Path, workdir: Path) -> None:
     """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep."""
-    dt = ballpit.load_scene(scene).scene.timestep
+    dt = read_scene(scene).timestep
     proc = subprocess.run(
         [sys.executable, "-m", "ballpit", "simulate", str(scene), "--duration", repr(steps * dt),
          "--out", str(out), "-q"],
@@ -94,6 +93,44 @@ def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_
     expected = np.load(tmp_path / "sim.npz")
     for column in TRAJECTORY_COLUMNS:
         assert record[column].dtype == expected[column].dtype, column
+        assert np.array_equal(record[column], expected[column]), column  # bit for bit
+
+
+@needs_xdotool
+def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals_simulate(xvfb, tmp_path):
+    # Run, pause, step back a second and a few steps through the history, resume, run on, quit: the
+    # record drops the steps that were dropped, so no step appears twice and it still equals an
+    # untouched ``ballpit simulate`` of as many steps, bit for bit.
+    scene = tmp_path / "slopes.toml"
+    shutil.copy(default_scene_path(), scene)
+    proc, _ = open_viewer(xvfb, tmp_path, str(scene), "--record", "run.npz")
+    try:
+        xdotool(xvfb, "key", "x")
+        time.sleep(2.0)
+        xdotool(xvfb, "key", "space")  # pause
+        time.sleep(0.3)
+        xdotool(xvfb, "key", "shift+Left")  # a second back
+        for _ in range(3):
+            xdotool(xvfb, "key", "Left")  # and three steps
+        time.sleep(0.3)
+        xdotool(xvfb, "key", "space")  # resume from the past: the later history is dropped
+        time.sleep(1.0)
+        xdotool(xvfb, "key", "Escape")
+        time.sleep(0.3)
+        xdotool(xvfb, "key", "Escape")
+        _out, err = finish(proc)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0 and "Traceback" not in err, err
+    record = np.load(tmp_path / "run.npz")
+    times = record["time"].reshape(-1, 5)[:, 0]  # five balls a record
+    assert np.all(np.diff(times) > 0)  # no step twice, no jump back in time
+    steps = len(times) - 1
+    assert steps > 100, steps
+    simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
+    expected = np.load(tmp_path / "sim.npz")
+    for column in TRAJECTORY_COLUMNS:
         assert np.array_equal(record[column], expected[column]), column  # bit for bit
 
 
@@ -138,12 +175,13 @@ def test_the_close_button_writes_the_record_and_a_reset_starts_the_timeline_agai
     times = np.unique(record["time"])
     assert times[0] == 0.0 and np.all(np.diff(times) > 0)  # from the reset on: no jump back in time
     assert len(times) - 1 == r["steps_since_reset"]
-    world = ballpit.load_scene(tmp_path / "live.toml")
+    live = read_scene(tmp_path / "live.toml")
+    world = live.world
     from ballpit.simulate import run
     from ballpit.writers import TrajectoryWriter
 
     writer = TrajectoryWriter(tmp_path / "sim.npz", len(world.spheres))
-    run(world, r["steps_since_reset"] * world.scene.timestep, trajectory=writer)
+    run(world, r["steps_since_reset"] * live.timestep, dt=live.timestep, trajectory=writer)
     writer.commit()
     expected = np.load(tmp_path / "sim.npz")
     for column in TRAJECTORY_COLUMNS:

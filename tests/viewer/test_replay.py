@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.scene import read_scene
 from ballpit.viewer.replay import Replay, TrajectoryError, read_trajectory
 
 from ..test_cli import assert_user_error
@@ -41,7 +42,7 @@ def test_simulate_output_reads_back_as_the_run_it_recorded(runs):
     assert npz.frames == csv.frames == 25  # the initial state and every 5th of 120 steps
     assert np.allclose(npz.times, csv.times, rtol=1e-8, atol=0)  # CSV keeps 9 digits
     assert np.allclose(npz.position, csv.position, rtol=1e-8, atol=1e-12)
-    dt = world.scene.timestep
+    dt = read_scene(SCENES / "slopes.toml").timestep
     for _ in range(5 * 7):
         world.step(dt)
     assert np.array_equal(npz.position[7], world.spheres.positions)  # .npz is bit for bit
@@ -52,7 +53,9 @@ def test_a_replay_writes_its_frames_into_the_scene_world(runs):
     world = ballpit.load_scene(SCENES / "slopes.toml")
     trajectory = read_trajectory(runs["npz"])
     replay = Replay(world, trajectory)
-    assert replay.latest == 24 and replay.timestep == pytest.approx(5 * world.scene.timestep)
+    assert replay.latest == 24 and replay.timestep == pytest.approx(
+        5 * read_scene(SCENES / "slopes.toml").timestep
+    )
     replay.seek(10)
     assert np.array_equal(world.spheres.velocities, trajectory.velocity[10])
     assert world.time == trajectory.times[10]

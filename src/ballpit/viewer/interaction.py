@@ -19,8 +19,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from ballpit.scene.colours import palette_colors
+
 from . import overlays
-from .appearance import PALETTE
 from .camera import WORLD_UP, Camera
 from .picking import Ray, camera_basis, pick, pointer_ray, ray_plane_point
 from .simulation import Phase, Simulation
@@ -199,7 +200,7 @@ class Interaction:
         mass = float(np.median(spheres.masses)) if len(spheres) else SHOT_MASS
         forward = camera.forward
         start = np.asarray(camera.position, dtype=float) + forward * (2.0 * radius + camera.near)
-        color = PALETTE[len(spheres) % len(PALETTE)]
+        color = palette_colors(1, first=len(spheres))[0]
         return self.sim.add_ball(
             color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed
         )

@@ -5,6 +5,8 @@ The record starts with the state the run starts from and gains one record after 
 takes, through the same writer ``simulate`` uses, so a record of an untouched run equals ``ballpit
 simulate`` of the scene for as many steps, bit for bit. Balls added while running (B) get the next ids
 from the step after they appear. A reset (R) or a reload starts the timeline again from its new start.
+Resuming from the past (after stepping back through the history) drops the records of the steps that
+were dropped, so the record holds the timeline as it stands, with no step twice.
 """
 
 from __future__ import annotations
@@ -26,9 +28,13 @@ class Recorder:
         self._start()
         sim.after_step.append(self.record)
         sim.after_reset.append(self.restart)
+        sim.after_resume_from_past.append(self.cut)
 
     def _start(self) -> None:
-        self.writer = TrajectoryWriter(self.path, len(self.sim.world.spheres), option="--record")
+        # one record per chunk, so the steps after a point in the past can be cut off again
+        self.writer = TrajectoryWriter(
+            self.path, len(self.sim.world.spheres), option="--record", records_per_chunk=1
+        )
         self.record()  # where the run starts
 
     @property
@@ -40,11 +46,19 @@ class Recorder:
         """Step hook: append the world's state now."""
         if self.finished:
             return
+        history = self.sim.timeline.history
+        if history is not None:  # a step taken after the future was dropped (resumed or edited in the past)
+            self.writer.truncate(history.current)
         world = self.sim.world
         balls = world.spheres
         self.writer.record(
             world.time, balls.positions, balls.velocities, balls.angular_velocities, balls.orientations
         )
+
+    def cut(self, step: int) -> None:
+        """Resume hook: the run goes on from ``step`` (since the start); later records are dropped."""
+        if not self.finished:
+            self.writer.truncate(step + 1)
 
     def restart(self) -> None:
         """Reset hook: the timeline starts again from the new world's start."""

@@ -110,6 +110,7 @@ class Simulation:
         self.before_step: list[Callable[[], None]] = []
         self.after_step: list[Callable[[], None]] = []
         self.after_reset: list[Callable[[], None]] = []
+        self.after_resume_from_past: list[Callable[[int], None]] = []  # gets the step resumed from
         self._install(scene_of(world, path))
 
     # ------------------------------------------------------------------ world management
@@ -195,6 +196,8 @@ class Simulation:
             self.message = "resumed"
             if self.timeline.resumed():
                 self.message = "resumed from the past: the later history is dropped"
+                for hook in self.after_resume_from_past:
+                    hook(self.timeline.history.current)
         else:
             self.message = "press X to start the drop"
 
