@@ -154,6 +154,8 @@ def test_slopes_scene_layout():
     tilts = {round(math.degrees(math.acos(p.normal[1])), 3) for p in slopes}
     normals = {tuple(np.round(p.normal, 6)) for p in slopes}
     assert len(tilts) == 4 and len(normals) == 4, "each tilted differently"
+    bounciness = {p.restitution for p in slopes}
+    assert len(bounciness) == 4, "each as bouncy as no other, so their colours differ"
     assert all(p.position[1] - 0.5 * p.size[0] > 0 for p in slopes), "slopes are above the ground"
     heights = world.spheres.positions[:, 1]
     assert len(heights) == 5 and heights.argmax() == 4, "the fifth ball starts highest"
