@@ -11,6 +11,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import ballpit
+from ballpit.scene import read_scene
 from ballpit.viewer.camera import Camera
 from ballpit.viewer.save import euler_xyz_degrees, save_scene, saved_path
 from ballpit.viewer.simulation import Simulation
@@ -112,13 +113,14 @@ def test_a_tilted_plane_moved_balls_and_an_added_ball_save_and_load_back_the_sam
                     "# the live choice may differ"):  # fmt: skip
         assert comment in text, comment
     assert "[[grid]]" not in text  # its balls moved: they are spheres now
-    loaded = ballpit.load_scene(saved)
+    reloaded = read_scene(saved)
+    loaded, look_of = reloaded.world, reloaded.appearance
     assert len(loaded.spheres) == 1 + 4 + 1
     assert_same_world(loaded, world)
-    assert np.allclose(loaded.scene.camera_position, camera.position)
-    look = loaded.scene.camera_look_at - loaded.scene.camera_position
+    assert np.allclose(look_of.camera_position, camera.position)
+    look = look_of.camera_look_at - look_of.camera_position
     assert np.allclose(look / np.linalg.norm(look), camera.forward)
-    assert np.allclose(loaded.scene.sphere_colors[-1], (0.1, 0.2, 0.3))
+    assert np.allclose(look_of.sphere_colors[-1], (0.1, 0.2, 0.3))
 
     check = subprocess.run(
         [sys.executable, "-m", "ballpit", "check", str(saved)], env=subprocess_env(None),
