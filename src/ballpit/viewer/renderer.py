@@ -111,7 +111,7 @@ class Renderer:
         self._instances = np.zeros((0, BALL_STRIDE), dtype=np.float32)
         self.ball_count = 0
 
-        # planes: two triangles each, rebuilt only when the scene changes
+        # planes: two triangles each, rebuilt when the scene changes or a plane moves
         self.plane_vao = GL.glGenVertexArrays(1)
         self.plane_vbo = GL.glGenBuffers(1)
         GL.glBindVertexArray(self.plane_vao)
@@ -139,7 +139,7 @@ class Renderer:
     def set_planes(
         self, centers: np.ndarray, orientations: np.ndarray, half_sizes: np.ndarray, colors: np.ndarray
     ) -> None:
-        """Build the plane quads (call when the scene changes, not per frame)."""
+        """Build the plane quads: when the scene changes or a plane moved (a few planes: cheap)."""
         centers = np.asarray(centers, dtype=float).reshape(-1, 3)
         count = len(centers)
         q = np.asarray(orientations, dtype=float).reshape(-1, 4)
@@ -161,7 +161,7 @@ class Renderer:
         data[..., 7:10] = n[:, None, :]
         data[..., 10:13] = np.asarray(colors, dtype=float).reshape(-1, 3)[:, None, :]
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STATIC_DRAW)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.plane_vertices = count * 6
         self._plane_centers, self._plane_normals = centers, n
