@@ -486,6 +486,8 @@ PLANE_KEYS = (
     "restitution",
     "friction",
     "rolling_friction",
+    "velocity",
+    "angular_velocity",
     "color",
 )
 BALL_KEYS = (
@@ -667,6 +669,8 @@ class _Builder:
             restitution=restitution,
             friction=e.number("friction", 0.5, nonnegative=True),
             rolling_friction=e.number("rolling_friction", 0.0, nonnegative=True),
+            velocity=e.vector("velocity", (0.0, 0.0, 0.0)),
+            angular_velocity=e.vector("angular_velocity", (0.0, 0.0, 0.0)),
         )
         color = e.color("color")
         if color is None:
