@@ -7,9 +7,7 @@
 //
 // The balls shade the front faces: each one near the ray towards the sun casts a soft-edged shadow,
 // and each one close by hides part of the sky (contact darkening). The renderer bins the balls in a
-// grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only the cells around it.
-// The finite planes shade each other too (a plank over the floor, the walls of a box): the ray towards
-// the sun is tested against each of them, with the same soft edge.
+// grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only its own cell.
 
 #include "common.glsl"
 
@@ -27,14 +25,6 @@ uniform vec2 u_shadow_origin;           // grid coordinates (m) of the corner of
 uniform float u_shadow_inverse_cell;    // 1 / cell size (1/m)
 uniform vec2 u_shadow_shape;            // cells along u and v; (0, 0): no shadows
 uniform float u_shadow_reach;           // ball radii from the centre where a ball's shading ends
-
-#define MAX_CASTERS 8                   // finite planes that cast shadows (the renderer's MAX_CASTERS)
-uniform int u_caster_count;
-uniform vec3 u_caster_center[MAX_CASTERS];
-uniform vec3 u_caster_normal[MAX_CASTERS];
-uniform vec3 u_caster_u[MAX_CASTERS];   // width axis
-uniform vec3 u_caster_v[MAX_CASTERS];   // depth axis
-uniform vec2 u_caster_half[MAX_CASTERS];
 
 out vec4 frag_color;
 
@@ -97,23 +87,6 @@ vec2 ball_shading(vec3 p, vec3 n) {
     return vec2(sun, ambient);
 }
 
-// The fraction of the sun a point sees past the finite planes: where its ray towards the sun crosses
-// a plane inside the rectangle it is in shadow, with a soft edge that widens with the distance.
-float plane_shadow(vec3 p) {
-    float sun = 1.0;
-    for (int k = 0; k < u_caster_count; ++k) {
-        float facing = dot(u_sun_direction, u_caster_normal[k]);
-        if (abs(facing) < 1e-4) continue;                 // the sun's rays run along this plane
-        float s = dot(u_caster_center[k] - p, u_caster_normal[k]) / facing;
-        if (s < 1e-3) continue;                           // behind the point, or its own plane
-        vec3 q = p + u_sun_direction * s - u_caster_center[k];
-        vec2 outside = abs(vec2(dot(q, u_caster_u[k]), dot(q, u_caster_v[k]))) - u_caster_half[k];
-        float w = s * SUN_RADIUS + 1e-3;
-        sun = min(sun, smoothstep(-w, w, max(outside.x, outside.y)));
-    }
-    return sun;
-}
-
 void main() {
     vec3 n = gl_FrontFacing ? v_normal : -v_normal;
     vec2 cell = floor(v_local);
@@ -135,11 +108,7 @@ void main() {
         alpha = mix(mix(BACK_ALPHA, BACK_GRID_ALPHA, lines), BACK_EDGE_ALPHA, edge);
     }
 
-    vec2 shading = vec2(1.0);
-    if (gl_FrontFacing) {
-        shading = ball_shading(v_world, n);
-        if (dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, plane_shadow(v_world));
-    }
+    vec2 shading = gl_FrontFacing ? ball_shading(v_world, n) : vec2(1.0);
     vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

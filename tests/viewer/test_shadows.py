@@ -188,21 +188,3 @@ def test_the_sun_grid_stays_bounded():
     assert len(grid.starts) == grid.cells + 1 and grid.starts[-1] == len(grid.balls)
     assert np.all(np.bincount(np.zeros(1, int)) >= 0)
     assert np.all(np.diff(grid.starts) <= shadows.LIMIT)
-
-
-def test_a_finite_plane_casts_its_shadow_onto_the_floor(offscreen):
-    """A plate 1 m above the floor shades the floor where the plate's shadow falls, offset away from
-    the sun, and not the floor right under its far edge."""
-    world = ballpit.World(gravity=(0, 0, 0))
-    world.add_plane(position=(0, 0, 0))
-    world.add_plane(position=(0, 1.0, 0), size=0.8)
-    sim = Simulation(world)
-    shaded = brightness(offscreen.render(sim, CAMERA))
-    empty = brightness(offscreen.render(floor_scene([]), CAMERA))
-    dark = empty - shaded
-    center = shadow_center((0.0, 1.0, 0.0))  # where the plate's centre casts
-    plate_covers = sphere_mask(CAMERA, (0.0, 1.0, 0.0), 0.6)  # roughly the plate itself
-    assert not plate_covers[pixel(center)]
-    assert dark[pixel(center)] > 100
-    for far in ([2.0, 0.0, 1.5], [-3.0, 0.0, 0.5]):
-        assert abs(dark[pixel(far)]) <= 3

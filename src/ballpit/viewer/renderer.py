@@ -12,8 +12,7 @@ not writing depth). The second pass is skipped when the eye is on the front side
 
 The balls cast shadows onto the planes' front faces and darken them where they touch (see
 shadows.py): each frame the balls are binned in a grid seen from the sun, uploaded as two texture
-buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call. The first
-``MAX_CASTERS`` finite planes cast shadows onto the planes too (uniform arrays; not onto the balls).
+buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call.
 """
 
 from __future__ import annotations
@@ -38,7 +37,6 @@ BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), col
 PLANE_STRIDE = 13  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3)
 SORT_THRESHOLD = 256  # sort balls front to back above this many
 SHADOW_BALLS_UNIT, SHADOW_STARTS_UNIT = 1, 2  # texture units of the shadow grid's buffers
-MAX_CASTERS = 8  # finite planes that cast shadows onto the others (plane.frag's MAX_CASTERS)
 _FLOAT = 4
 
 
@@ -130,7 +128,6 @@ class Renderer:
         self.plane_vertices = 0
         self._plane_centers = np.zeros((0, 3))
         self._plane_normals = np.zeros((0, 3))
-        self._casters: dict[str, np.ndarray] = {}
 
         # ball shadows: the grid of balls seen from the sun, two texture buffers the plane shader reads
         self.shadows = True  # False: planes are drawn without ball shadows or contact darkening
@@ -197,14 +194,6 @@ class Renderer:
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.plane_vertices = count * 6
         self._plane_centers, self._plane_normals = centers, n
-        finite = np.flatnonzero(~infinite.any(axis=1))[:MAX_CASTERS]
-        self._casters = {
-            "u_caster_center": centers[finite],
-            "u_caster_normal": n[finite],
-            "u_caster_u": u[finite],
-            "u_caster_v": v[finite],
-            "u_caster_half": half[finite],
-        }
 
     def upload_balls(
         self,
@@ -285,10 +274,6 @@ class Renderer:
         program.set("u_shadow_inverse_cell", 1.0 / grid.cell_size)
         program.set("u_shadow_shape", np.array(grid.shape, dtype=np.float32))
         program.set("u_shadow_reach", shadows.REACH)
-        casters = self._casters if self.shadows else {}
-        program.set_int("u_caster_count", len(casters.get("u_caster_center", ())))
-        for name, values in casters.items():
-            program.set_array(name, values)
         for unit, texture in ((SHADOW_BALLS_UNIT, self.shadow_textures[0]),
                               (SHADOW_STARTS_UNIT, self.shadow_textures[1])):  # fmt: skip
             GL.glActiveTexture(GL.GL_TEXTURE0 + unit)

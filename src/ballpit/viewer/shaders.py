@@ -143,18 +143,6 @@ class Program:
             setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv, 4: GL.glUniform4fv}[arr.shape[-1]]
             setter(loc, 1, arr)
 
-    def set_array(self, uniform: str, values: object) -> None:
-        """Set a uniform array of floats, vec2 or vec3 from a (K,) / (K, 2) / (K, 3) array."""
-        from OpenGL import GL
-
-        loc = self.location(uniform)
-        arr = np.ascontiguousarray(values, dtype=np.float32)
-        if loc < 0 or len(arr) == 0:
-            return
-        width = 1 if arr.ndim == 1 else arr.shape[-1]
-        setter = {1: GL.glUniform1fv, 2: GL.glUniform2fv, 3: GL.glUniform3fv}[width]
-        setter(loc, len(arr), arr)
-
     def set_int(self, uniform: str, value: int) -> None:
         """Set an int uniform, such as the texture unit a sampler reads (the program must be in use)."""
         from OpenGL import GL
