@@ -13,16 +13,13 @@
 
 in vec3 v_world;
 in vec2 v_local;
+in vec2 v_shadow_grid;                  // grid coordinates of v_world, from plane.vert
 flat in vec2 v_half_size;
 flat in vec3 v_normal;
 flat in vec3 v_color;
 
 uniform samplerBuffer u_shadow_balls;   // centre xyz, radius; grouped by cell, nearest the sun first
-uniform isamplerBuffer u_shadow_starts; // cell k's balls are [starts[k], starts[k + 1])
-uniform vec3 u_shadow_axis_u;           // grid axes, perpendicular to the sun
-uniform vec3 u_shadow_axis_v;
-uniform vec2 u_shadow_origin;           // grid coordinates (m) of the corner of cell (0, 0)
-uniform float u_shadow_inverse_cell;    // 1 / cell size (1/m)
+uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, cells[k].y)
 uniform vec2 u_shadow_shape;            // cells along u and v; (0, 0): no shadows
 uniform float u_shadow_reach;           // ball radii from the centre where a ball's shading ends
 
@@ -48,41 +45,32 @@ float grid(vec2 p, float spacing, float width_pixels) {
 const float SUN_RADIUS = 0.035;        // radians: a disc a little wider than the real sun, soft edges
 
 // The balls near this point's ray towards the sun: the fraction of the sun it sees (x) and the
-// fraction of the ambient light the close ones leave (y). Cells are at least two reaches wide, so the
-// 2 x 2 cells nearest to the point hold every ball that can shade it.
-vec2 ball_shading(vec3 p, vec3 n) {
-    vec2 g = (vec2(dot(p, u_shadow_axis_u), dot(p, u_shadow_axis_v)) - u_shadow_origin) * u_shadow_inverse_cell;
-    ivec2 shape = ivec2(u_shadow_shape);
-    ivec2 low = ivec2(floor(g - 0.5));
-    int i0 = max(low.x, 0);
-    int i1 = min(low.x + 1, shape.x - 1);
-    int j0 = max(low.y, 0);
-    int j1 = min(low.y + 1, shape.y - 1);
-    if (i0 > i1 || j0 > j1) return vec2(1.0);
+// fraction of the ambient light the close ones leave (y). Its cell holds every ball that can shade it.
+// A CPU rasteriser runs the code after a per-pixel branch anyway (masked), so this is kept short, and
+// the grid coordinates come interpolated from the vertex shader.
+vec2 ball_shading(vec3 p, vec3 n, vec2 g) {
+    bool inside = all(greaterThanEqual(g, vec2(0.0))) && all(lessThan(g, u_shadow_shape));
+    ivec2 c = ivec2(clamp(g, vec2(0.0), max(u_shadow_shape - 1.0, vec2(0.0))));
+    ivec2 rows = inside ? texelFetch(u_shadow_cells, c.y * int(u_shadow_shape.x) + c.x).xy : ivec2(0);
     bool lit_side = dot(n, u_sun_direction) > 0.0;
     float sun = 1.0;
     float ambient = 1.0;
-    for (int j = j0; j <= j1; ++j) {
-        // cells i0..i1 of row j are one run of balls
-        int first = texelFetch(u_shadow_starts, j * shape.x + i0).r;
-        int last = texelFetch(u_shadow_starts, j * shape.x + i1 + 1).r;
-        for (int i = first; i < last; ++i) {
-            vec4 ball = texelFetch(u_shadow_balls, i);
-            float r = ball.w;
-            vec3 d = ball.xyz - p;
-            float l2 = dot(d, d);
-            float t = dot(d, u_sun_direction);          // along the ray to the sun
-            if (lit_side && t > 0.0) {
-                float miss = sqrt(max(l2 - t * t, 0.0));  // how far the ray passes from the centre
-                float w = min(t * SUN_RADIUS, (u_shadow_reach - 1.0) * r) + 1e-4;  // within reach
-                sun = min(sun, smoothstep(-w, w, miss - r));
-            }
-            // the sky the ball hides, cosine weighted: (r/l)^2 cos(theta), all of it where it touches
-            float l = sqrt(l2);
-            float hidden = max(dot(n, d), 0.0) / l * r * r / l2;
-            hidden *= 1.0 - smoothstep(0.6 * u_shadow_reach * r, u_shadow_reach * r, l);
-            ambient *= 1.0 - min(hidden, 1.0);
+    for (int i = rows.x; i < rows.y; ++i) {
+        vec4 ball = texelFetch(u_shadow_balls, i);
+        float r = ball.w;
+        vec3 d = ball.xyz - p;
+        float l2 = dot(d, d);
+        float t = dot(d, u_sun_direction);          // along the ray to the sun
+        if (lit_side && t > 0.0) {
+            float miss = sqrt(max(l2 - t * t, 0.0));  // how far the ray passes from the centre
+            float w = min(t * SUN_RADIUS, (u_shadow_reach - 1.0) * r) + 1e-4;  // within reach
+            sun = min(sun, smoothstep(-w, w, miss - r));
         }
+        // the sky the ball hides, cosine weighted: (r/l)^2 cos(theta), all of it where it touches
+        float l = sqrt(l2);
+        float hidden = max(dot(n, d), 0.0) / l * r * r / l2;
+        hidden *= 1.0 - smoothstep(0.6 * u_shadow_reach * r, u_shadow_reach * r, l);
+        ambient *= 1.0 - min(hidden, 1.0);
     }
     return vec2(sun, ambient);
 }
@@ -108,7 +96,7 @@ void main() {
         alpha = mix(mix(BACK_ALPHA, BACK_GRID_ALPHA, lines), BACK_EDGE_ALPHA, edge);
     }
 
-    vec2 shading = gl_FrontFacing ? ball_shading(v_world, n) : vec2(1.0);
+    vec2 shading = gl_FrontFacing ? ball_shading(v_world, n, v_shadow_grid) : vec2(1.0);
     vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

@@ -36,7 +36,7 @@ NO_EDGE = 1.0e6  # "half size" given to the shader for infinite planes: no edge 
 BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), colour (3), spare
 PLANE_STRIDE = 13  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3)
 SORT_THRESHOLD = 256  # sort balls front to back above this many
-SHADOW_BALLS_UNIT, SHADOW_STARTS_UNIT = 1, 2  # texture units of the shadow grid's buffers
+SHADOW_BALLS_UNIT, SHADOW_CELLS_UNIT = 1, 2  # texture units of the shadow grid's buffers
 _FLOAT = 4
 
 
@@ -138,7 +138,7 @@ class Renderer:
         self.shadow_buffers = GL.glGenBuffers(2)
         self.shadow_textures = GL.glGenTextures(2)
         for buffer, texture, fmt in zip(
-            self.shadow_buffers, self.shadow_textures, (GL.GL_RGBA32F, GL.GL_R32I), strict=True
+            self.shadow_buffers, self.shadow_textures, (GL.GL_RGBA32F, GL.GL_RG32I), strict=True
         ):
             GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, buffer)
             GL.glBufferData(GL.GL_TEXTURE_BUFFER, 16, None, GL.GL_STREAM_DRAW)
@@ -148,7 +148,7 @@ class Renderer:
         GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, 0)
         self.plane_program.use()
         self.plane_program.set_int("u_shadow_balls", SHADOW_BALLS_UNIT)
-        self.plane_program.set_int("u_shadow_starts", SHADOW_STARTS_UNIT)
+        self.plane_program.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
         GL.glUseProgram(0)
 
         # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
@@ -238,7 +238,7 @@ class Renderer:
             grid = shadows.build(positions, radii, self.sun_direction, limit=self.shadow_limit)
         else:
             grid = shadows.empty_grid(self.sun_direction)
-        for buffer, data in zip(self.shadow_buffers, (grid.balls, grid.starts), strict=True):
+        for buffer, data in zip(self.shadow_buffers, (grid.balls, grid.ranges), strict=True):
             GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, buffer)
             GL.glBufferData(GL.GL_TEXTURE_BUFFER, max(data.nbytes, 16), data if data.nbytes else None,
                             GL.GL_STREAM_DRAW)  # fmt: skip
@@ -275,7 +275,7 @@ class Renderer:
         program.set("u_shadow_shape", np.array(grid.shape, dtype=np.float32))
         program.set("u_shadow_reach", shadows.REACH)
         for unit, texture in ((SHADOW_BALLS_UNIT, self.shadow_textures[0]),
-                              (SHADOW_STARTS_UNIT, self.shadow_textures[1])):  # fmt: skip
+                              (SHADOW_CELLS_UNIT, self.shadow_textures[1])):  # fmt: skip
             GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
             GL.glBindTexture(GL.GL_TEXTURE_BUFFER, texture)
         GL.glActiveTexture(GL.GL_TEXTURE0)
