@@ -28,13 +28,14 @@ def measure(
 ) -> dict:
     from OpenGL import GL
 
-    import ballpit
+    from ballpit.scene import read_scene
     from ballpit.viewer.camera import Camera
     from ballpit.viewer.render import Offscreen
     from ballpit.viewer.simulation import Simulation
 
-    world = ballpit.load_scene(scene)
-    sim = Simulation(world, scene, step_budget=math.inf)  # time every step: nothing is dropped
+    loaded = read_scene(scene)
+    world = loaded.world
+    sim = Simulation(loaded, step_budget=math.inf)  # time every step: nothing is dropped
     for _ in range(round(skip / sim.timestep)):  # untimed: e.g. to time a pile landing, not its fall
         sim.world.step(sim.timestep)
     look = sim.appearance

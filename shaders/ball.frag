@@ -17,6 +17,7 @@ flat in vec3 v_color;
 
 uniform mat4 u_view_projection;
 uniform float u_multisample;   // 1: edge coverage goes to alpha-to-coverage; 0: a hard edge at r
+uniform float u_alpha;         // 1 for balls; below 1 for translucent ghosts (blended, coverage in alpha)
 
 out vec4 frag_color;
 
@@ -74,5 +75,5 @@ void main() {
     vec3 albedo = mix(v_color, WHITE, white_amount);
 
     vec3 color = fog(shade(albedo, n, hit, 48.0, 0.35), hit);
-    frag_color = vec4(color, u_multisample > 0.5 ? coverage : 1.0);
+    frag_color = vec4(color, (u_multisample > 0.5 ? coverage : 1.0) * u_alpha);
 }

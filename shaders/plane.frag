@@ -3,7 +3,8 @@
 // of finite planes so they read from any side, and fog with distance (the infinite ground fades into
 // the background). The front face (the side the normal points to) is opaque. The back face is a wall
 // you look through (the near wall of a closed box seen from outside): the renderer draws it after the
-// balls, blended, so it is a faint, darker tint with its grid and rim kept visible.
+// balls, blended, so it is a faint, darker tint with its grid and rim kept visible. The selected plane
+// (clicked in the viewer) has a wide amber rim, or an amber tint if it is infinite and has no rim.
 //
 // The balls shade the front faces: each one near the ray towards the sun casts a soft-edged shadow,
 // and each one close by hides part of the sky (contact darkening). The renderer bins the balls in a
@@ -17,6 +18,7 @@ in vec2 v_shadow_grid;                  // grid coordinates of v_world, from pla
 flat in vec2 v_half_size;
 flat in vec3 v_normal;
 flat in vec3 v_color;
+flat in float v_selected;
 
 uniform samplerBuffer u_shadow_balls;   // centre xyz, radius; grouped by cell, nearest the sun first
 uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, cells[k].y)
@@ -30,6 +32,8 @@ const vec3 EDGE_COLOR = vec3(0.96, 0.96, 0.90);
 const float BACK_ALPHA = 0.18;   // opacity of a back face's cells
 const float BACK_GRID_ALPHA = 0.45;
 const float BACK_EDGE_ALPHA = 0.9;
+const float SELECTED_EDGE_WIDTH = 0.16;   // metres
+const vec3 SELECTED_COLOR = vec3(1.0, 0.72, 0.05);
 
 // 1 where a grid line of the given spacing passes, 0 elsewhere, anti-aliased and faded out where the
 // lines get denser than the pixels.
@@ -88,8 +92,10 @@ void main() {
     vec2 inside = v_half_size - abs(v_local);
     float edge_distance = min(inside.x, inside.y);
     float aa = max(fwidth(edge_distance), 1e-6);
-    float edge = 1.0 - smoothstep(EDGE_WIDTH - aa, EDGE_WIDTH + aa, edge_distance);
-    albedo = mix(albedo, EDGE_COLOR, edge);
+    float width = v_selected > 0.5 ? SELECTED_EDGE_WIDTH : EDGE_WIDTH;
+    float edge = 1.0 - smoothstep(width - aa, width + aa, edge_distance);
+    albedo = mix(albedo, v_selected > 0.5 ? SELECTED_COLOR : EDGE_COLOR, edge);
+    if (v_selected > 0.5 && v_half_size.x > 1.0e5) albedo = mix(albedo, SELECTED_COLOR, 0.35);
 
     float alpha = 1.0;
     if (!gl_FrontFacing) {

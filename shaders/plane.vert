@@ -1,7 +1,8 @@
 #version 330 core
 // Planes as quads. Each vertex carries its plane-local coordinates (metres from the centre along the
 // plane's width and depth axes) for the grid, the plane's half extents for the edge band, its normal
-// and its colour (bounciness).
+// and its colour (bounciness). Each plane is 6 consecutive vertices, so gl_VertexID / 6 is its index;
+// the selected one (u_selected, -1 for none) is flagged for a highlighted rim.
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec2 a_local;
@@ -14,6 +15,7 @@ uniform vec3 u_shadow_axis_u;           // the sun's grid (see plane.frag)
 uniform vec3 u_shadow_axis_v;
 uniform vec2 u_shadow_origin;
 uniform float u_shadow_inverse_cell;
+uniform float u_selected;
 
 out vec3 v_world;
 out vec2 v_local;
@@ -21,6 +23,7 @@ flat out vec2 v_half_size;
 flat out vec3 v_normal;
 flat out vec3 v_color;
 out vec2 v_shadow_grid;  // the position's grid coordinates: affine, so interpolating them is exact
+flat out float v_selected;
 
 void main() {
     v_world = a_position;
@@ -30,5 +33,6 @@ void main() {
     v_half_size = a_half_size;
     v_normal = a_normal;
     v_color = a_color;
+    v_selected = abs(float(gl_VertexID / 6) - u_selected) < 0.5 ? 1.0 : 0.0;
     gl_Position = u_view_projection * vec4(a_position, 1.0);
 }

@@ -1,5 +1,9 @@
 """`ballpit bench`: the workloads are the scenes they claim to be, and the table reports every row."""
 
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -29,8 +33,8 @@ def test_settled_layout_is_columns_of_touching_balls_on_the_floor():
 def test_bench_prints_a_row_per_workload_and_size(capsys):
     assert bench.main(["--workload", "pile", "--sizes", "8,27", "--steps", "3"]) == 0
     out = capsys.readouterr().out
-    rows = [line.split() for line in out.splitlines() if line.startswith("ballpit  ")]
-    table = rows[len(rows) // 2 :]  # rows print as they finish, then again as one table
+    assert out.count("steps/s") == 1, "one table, printed once"
+    table = [line.split() for line in out.splitlines() if line.startswith("ballpit  ")]
     assert [(r[1], int(r[2]), int(r[3])) for r in table] == [("pile", 8, 3), ("pile", 27, 3)]
     assert all(float(r[4]) > 0 and float(r[5]) > 0 for r in table)
 
@@ -40,3 +44,32 @@ def test_bench_rejects_sizes_that_are_not_positive_integers(capsys):
         bench.main(["--sizes", "10,ten"])
     assert exc.value.code == 2
     assert "sizes must be integers" in capsys.readouterr().err
+
+
+def test_bench_from_the_folder_above_a_clone_is_not_shadowed_by_it(tmp_path):
+    """A folder named ``ballpit`` in the working directory (a clone) must not replace the package."""
+    (tmp_path / "ballpit" / "src").mkdir(parents=True)
+    script = Path(sys.executable).parent / "ballpit"
+    args = ["bench", "--workload", "free", "--sizes", "8", "--steps", "2"]
+    r = subprocess.run([str(script), *args], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert [line.split()[:3] for line in r.stdout.splitlines() if line.startswith("ballpit  ")] == [
+        ["ballpit", "free", "8"]
+    ]
+
+
+def test_a_failing_row_shows_the_childs_error_and_exits_non_zero(tmp_path, monkeypatch, capsys):
+    """Children that cannot import ballpit: each row names the child's error; the status is 1."""
+    broken = tmp_path / "broken" / "ballpit"
+    broken.mkdir(parents=True)
+    (broken / "__init__.py").write_text('raise RuntimeError("this ballpit is broken")\n')
+    monkeypatch.setenv("PYTHONPATH", str(broken.parent))  # read by the children only
+    assert bench.main(["--workload", "free", "--sizes", "8,27", "--steps", "2"]) == 1
+    out, err = capsys.readouterr()
+    assert not [line for line in out.splitlines() if line.startswith("ballpit  ")]
+    lines = err.strip().splitlines()
+    assert lines[:2] == [
+        "ballpit bench: ballpit free N=8: failed: RuntimeError: this ballpit is broken",
+        "ballpit bench: ballpit free N=27: failed: RuntimeError: this ballpit is broken",
+    ]
+    assert lines[2:] == ["ballpit bench: 2 of 2 measurements failed"]

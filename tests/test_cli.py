@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -152,10 +153,24 @@ def test_directory_and_binary_files(tmp_path):
         (["render", "scenes/slopes.toml", "--out", "x.gif", "--size", "big"], "--size"),
         (["render", "scenes/slopes.toml", "--out", "x.mp4"], "x.mp4"),
         (["nonsense"], "nonsense"),
+        (["render", "scenes/slopes.toml"], "--out"),
+        (["render", "scenes/slopes.toml", "--out", "x.gif", "--fps", "0"], "--fps"),
+        (["check"], "scene"),
+        (["check", "scenes/slopes.toml", "extra"], "extra"),
+        (["simulate", "scenes/slopes.toml", "--out"], "--out"),
+        (["bench", "--sizes", "abc"], "--sizes"),
+        (["bench", "--sizes", "0"], "--sizes"),
+        (["bench", "--steps", "0"], "--steps"),
+        (["bench", "--workload", "moon"], "--workload"),
+        (["bench", "--frobnicate"], "--frobnicate"),
+        (["bench", "--timeout", "-1"], "--timeout"),
+        (["simulate", "scenes/slopes.toml", "--integrator", "a\nb\x1b[31m"], "--integrator"),
+        (["simulate", "scenes/slopes.toml", "--out", "a\nb.txt"], "a\\nb.txt"),
     ],
 )
 def test_bad_options_exit_2_in_one_line(args, fragment):
-    assert_user_error(ballpit(*args), fragment)
+    line = assert_user_error(ballpit(*args), fragment)
+    assert line.startswith("ballpit") and "usage:" not in line and "\x1b" not in line
 
 
 def test_bad_output_paths_exit_2_and_leave_nothing(tmp_path):
@@ -335,3 +350,144 @@ def test_scenes_lists_the_bundled_scenes():
     assert r.returncode == 0
     names = [line.split()[0] for line in r.stdout.splitlines()]
     assert {"slopes", "cradle", "billiards", "incline", "pile", "pile10k"} <= set(names)
+
+
+def test_a_run_of_more_than_a_billion_steps_is_refused_naming_the_numbers(tmp_path):
+    r = ballpit("simulate", "scenes/slopes.toml", "--dt", "1e-300", timeout=30)
+    assert_user_error(r, "--dt 1e-300", "10 s", "1e+301 steps", "limit is 1e+09")
+    scene = tmp_path / "tiny.toml"
+    # the smallest timestep a scene file may give (1e-9 s) over 2 s is still too many steps
+    scene.write_text("[world]\ntimestep = 1e-9\n\n[[sphere]]\nposition = [0, 1, 0]\n")
+    r = ballpit("simulate", scene, "--duration", "2", timeout=30)
+    assert_user_error(r, str(scene), "timestep 1e-09", "2e+09 steps", "limit is 1e+09")
+    scene.write_text("[world]\ntimestep = 1e-300\n\n[[sphere]]\nposition = [0, 1, 0]\n")
+    r = ballpit("simulate", scene, "--duration", "2", timeout=30)
+    assert_user_error(r, str(scene), "timestep", "1e-300")  # refused by the scene file's own range
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "1e300", "--dt", "1e-300", timeout=30)
+    assert_user_error(r, "inf steps")
+
+
+@pytest.mark.parametrize("option", ["--out", "--events"])
+def test_a_file_name_over_255_bytes_is_one_line(tmp_path, option):
+    long_name = "é" * 130 + ".csv"  # 264 bytes in UTF-8
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.01", option, tmp_path / long_name)
+    assert_user_error(r, option, "264 bytes", "limit is 255")
+    r = ballpit(
+        "simulate", "scenes/slopes.toml", "--duration", "0.01", option, tmp_path / ("a" * 300) / "x.npz"
+    )
+    assert_user_error(r, option, "300 bytes")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_name_of_255_bytes_is_written(tmp_path):
+    """The temporary file beside it must fit too, although its name is longer."""
+    name = "é" * 125 + "a.csv"  # 255 bytes
+    r = ballpit("simulate", "scenes/slopes.toml", "--duration", "0.01", "--out", tmp_path / name, "-q")
+    assert r.returncode == 0, r.stderr
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+
+
+def start(*args: str | Path, **kwargs) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "ballpit", *map(str, args)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        **kwargs,
+    )
+
+
+def wait_for(condition, timeout: float = 60) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.05)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_or_sighup_during_simulate_leaves_no_partial_file(tmp_path, signum):
+    out, ev = tmp_path / "t.npz", tmp_path / "e.csv"
+    proc = start("simulate", "scenes/pile10k.toml", "--duration", "60", "--out", out, "--events", ev)
+    wait_for(lambda: sum(p.name.endswith(".partial") for p in tmp_path.iterdir()) == 2)
+    time.sleep(1.0)  # inside the stepping loop, with the writers open
+    proc.send_signal(signum)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signum, stderr
+    assert stderr.strip().splitlines()[-1] == f"ballpit: stopped by {signal.Signals(signum).name}"
+    assert "Traceback" not in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def _limit_file_size() -> None:
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))  # Python ignores SIGXFSZ: EFBIG
+
+
+@pytest.mark.parametrize("suffix", ["csv", "npz"])
+def test_a_write_that_fails_part_way_leaves_nothing(tmp_path, suffix):
+    """A file size limit makes the writes fail part way as a full disk does: one line, exit 1, no file."""
+    out = tmp_path / f"t.{suffix}"
+    proc = start("simulate", "scenes/pile.toml", "--duration", "1", "--out", out, preexec_fn=_limit_file_size)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 1, stderr
+    assert "Traceback" not in stderr
+    assert stderr.strip().splitlines() == [
+        f"ballpit: {out}: cannot write: File too large; nothing was written"
+    ]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 1 MB tmpfs (needs root; skipped otherwise)."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", disk],
+                                           capture_output=True).returncode:  # fmt: skip
+        pytest.skip("mounting a small tmpfs needs root")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", disk], check=True)
+
+
+@pytest.mark.parametrize("suffix", ["csv", "npz"])
+def test_a_full_disk_leaves_nothing(small_disk, suffix):
+    out, ev = small_disk / f"t.{suffix}", small_disk / f"e.{suffix}"
+    r = ballpit("simulate", "scenes/pile.toml", "--duration", "1", "--out", out, "--events", ev)
+    assert r.returncode == 1, r.stderr
+    assert "Traceback" not in r.stderr
+    line = r.stderr.strip().splitlines()[-1]
+    assert line.endswith("cannot write: No space left on device; nothing was written"), line
+    assert list(small_disk.iterdir()) == []
+
+
+def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
+    keep = tmp_path / "frames" / "notes.txt"  # not ours: stays
+    keep.parent.mkdir()
+    keep.write_text("mine\n")
+    for folder in (tmp_path / "frames", tmp_path / "new" / "frames"):
+        proc = start(
+            "render", "scenes/slopes.toml", "--out", f"{folder}/", "--duration", "5", "--size", "64x48"
+        )
+        wait_for(lambda f=folder: f.is_dir() and len(list(f.glob("frame_*.png"))) >= 5)
+        proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+        assert proc.returncode == 130, stderr
+        assert stderr.strip().splitlines()[-1] == "ballpit: interrupted"
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == [
+        "frames",
+        "frames/notes.txt",
+    ]
+
+
+def test_render_into_a_path_through_a_file_is_one_line(tmp_path):
+    (tmp_path / "notadir").write_text("a file\n")
+    for out in ("notadir/x.gif", "notadir/frames/", "notadir/deeper/x.png"):
+        r = ballpit("render", "scenes/slopes.toml", "--out", tmp_path / out)
+        assert_user_error(r, "--out", "notadir", "is a file, not a folder")
+    r = ballpit("render", "scenes/slopes.toml", "--out", tmp_path / ("a" * 300 + ".gif"))
+    assert_user_error(r, "--out", "304 bytes")
+    assert [p.name for p in tmp_path.iterdir()] == ["notadir"]

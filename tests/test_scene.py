@@ -10,7 +10,16 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import ballpit
-from ballpit.scene import PALETTE, SceneError, SceneInfo, first_overlap, load_scene, resolve_scene_path
+from ballpit.scene import (
+    PALETTE,
+    Appearance,
+    Scene,
+    SceneError,
+    first_overlap,
+    load_scene,
+    read_scene,
+    resolve_scene_path,
+)
 
 
 def write(tmp_path: Path, text: str, name: str = "scene.toml") -> Path:
@@ -26,7 +35,7 @@ def load_error(tmp_path: Path, text: str) -> SceneError:
 
 
 def test_a_full_scene_builds_the_world_it_describes(tmp_path):
-    world = load_scene(
+    scene = read_scene(
         write(
             tmp_path,
             """
@@ -70,6 +79,7 @@ color = [1, 0, 0.5]
 """,
         )
     )
+    world = scene.world
     assert ballpit.load_scene is load_scene
     assert np.allclose(world.gravity, [0, -3.5, 0])
     assert world.integrator == "rk2"
@@ -92,25 +102,26 @@ color = [1, 0, 0.5]
     assert (slope.restitution, slope.friction, slope.rolling_friction) == (0.4, 0.3, 0.01)
     assert world.planes[0].infinite
 
-    info = world.scene
-    assert isinstance(info, SceneInfo)
-    assert info.path == tmp_path / "scene.toml" and info.name == "scene"
+    info = scene.appearance
+    assert isinstance(scene, Scene) and isinstance(info, Appearance)
+    assert scene.path == info.path == tmp_path / "scene.toml" and scene.name == "scene"
     assert np.allclose(info.camera_position, [1, 2, 3]) and np.allclose(info.camera_look_at, [0, 1, 0])
     assert np.allclose(info.sphere_colors, [[1, 0, 0.5]])
     assert np.allclose(info.plane_colors[1], [0x10 / 255, 0x20 / 255, 0x30 / 255])
-    assert info.timestep == 0.01 and info.duration == 3.0
+    assert scene.timestep == 0.01 and scene.duration == 3.0
 
 
 def test_defaults_match_the_design(tmp_path):
-    world = load_scene(write(tmp_path, "[[plane]]\nposition = [0, 0, 0]\n[[sphere]]\nposition = [0, 1, 0]\n"))
+    scene = read_scene(write(tmp_path, "[[plane]]\nposition = [0, 0, 0]\n[[sphere]]\nposition = [0, 1, 0]\n"))
+    world = scene.world
     assert np.allclose(world.gravity, [0, -9.81, 0]) and world.integrator == "rk4"
     ball, plane = world.spheres[0], world.planes[0]
     assert ball.radius == 0.5 and ball.mass == 1.0 and not ball.hollow
     assert (ball.restitution, ball.friction, ball.rolling_friction) == (1.0, 0.5, 0.0)
     assert (plane.restitution, plane.friction, plane.rolling_friction) == (0.8, 0.5, 0.0)
     assert plane.infinite and np.allclose(plane.normal, [0, 1, 0])
-    info = world.scene
-    assert info.timestep == pytest.approx(1 / 240) and info.duration is None
+    info = scene.appearance
+    assert scene.timestep == pytest.approx(1 / 240) and scene.duration is None
     assert info.sphere_colors.shape == (1, 3) and info.plane_colors.shape == (1, 3)
     assert np.all((info.sphere_colors >= 0) & (info.sphere_colors <= 1))
     # no [camera]: one is placed in front of the scene, looking at it
@@ -118,22 +129,22 @@ def test_defaults_match_the_design(tmp_path):
 
 
 def test_scene_info_is_read_only(tmp_path):
-    info = load_scene(write(tmp_path, "[[sphere]]\nposition = [0, 1, 0]\n")).scene
+    scene = read_scene(write(tmp_path, "[[sphere]]\nposition = [0, 1, 0]\n"))
     with pytest.raises(ValueError):
-        info.sphere_colors[0, 0] = 0.0
+        scene.appearance.sphere_colors[0, 0] = 0.0
     with pytest.raises(AttributeError):
-        info.timestep = 1.0  # type: ignore[misc]
+        scene.timestep = 1.0  # type: ignore[misc]
 
 
 def test_default_ball_colours_cycle_the_palette(tmp_path):
     text = "".join(f"[[sphere]]\nposition = [{2 * k}, 1, 0]\n" for k in range(len(PALETTE) + 2))
-    colors = load_scene(write(tmp_path, text)).scene.sphere_colors
+    colors = read_scene(write(tmp_path, text)).appearance.sphere_colors
     assert np.allclose(colors[0], colors[len(PALETTE)])
     assert len({tuple(c) for c in colors[: len(PALETTE)]}) == len(PALETTE)
 
 
 def test_grid_places_a_block_of_balls(tmp_path):
-    world = load_scene(
+    scene = read_scene(
         write(
             tmp_path,
             """
@@ -148,14 +159,14 @@ color = "#ff0000"
 """,
         )
     )
-    balls = world.spheres
+    balls = scene.world.spheres
     assert len(balls) == 24
     pos = balls.positions
     assert np.allclose(pos.min(axis=0), [1, 2, 3])
     assert np.allclose(pos.max(axis=0), [1.5, 3.2, 5.1])
     assert np.allclose(balls.radii, 0.2) and np.allclose(balls.masses, 0.3)
     assert np.allclose(balls.velocities, [0, -1, 0])
-    assert np.allclose(world.scene.sphere_colors, [1, 0, 0])
+    assert np.allclose(scene.appearance.sphere_colors, [1, 0, 0])
 
 
 def test_grid_center_jitter_and_seed_are_deterministic(tmp_path):
@@ -177,7 +188,7 @@ def test_grid_center_jitter_and_seed_are_deterministic(tmp_path):
 
 def test_grid_colour_list_cycles(tmp_path):
     text = '[[grid]]\ncorner = [0, 1, 0]\ncount = [3, 1, 1]\ncolor = ["#ff0000", [0, 0, 1]]\n'
-    colors = load_scene(write(tmp_path, text)).scene.sphere_colors
+    colors = read_scene(write(tmp_path, text)).appearance.sphere_colors
     assert np.allclose(colors, [[1, 0, 0], [0, 0, 1], [1, 0, 0]])
 
 
@@ -276,3 +287,16 @@ def test_resolve_scene_path_finds_bundled_scenes_by_name(tmp_path):
     assert resolve_scene_path("slopes").name == "slopes.toml"
     assert resolve_scene_path("slopes.toml").is_file()
     assert resolve_scene_path(tmp_path / "missing.toml") == tmp_path / "missing.toml"
+
+
+def test_a_plane_moves_as_its_scene_table_says(tmp_path):
+    world = load_scene(
+        write(tmp_path, "[[plane]]\nsize = 2\nvelocity = [0, 1, 0]\nangular_velocity = [0, 0, 0.5]\n")
+    )
+    plane = world.planes[0]
+    assert plane.velocity == pytest.approx((0, 1, 0)) and plane.angular_velocity == pytest.approx((0, 0, 0.5))
+    world.step(0.5)
+    assert plane.position == pytest.approx((0, 0.5, 0))
+    assert plane.normal == pytest.approx((-np.sin(0.25), np.cos(0.25), 0))  # turned 0.25 rad about z
+    error = load_error(tmp_path, "[[plane]]\nangular_velocity = [0, 'fast', 0]\n")
+    assert "angular_velocity" in str(error) and "plane #1" in str(error)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit.scene import bundled_scenes, load_scene
+from ballpit.scene import bundled_scenes, load_scene, read_scene
 from ballpit.viewer.camera import Camera
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -59,9 +59,10 @@ def test_the_required_scenes_are_bundled():
 def test_every_bundled_scene_checks_and_simulates(tmp_path, path):
     r = ballpit("check", path)
     assert r.returncode == 0 and ": ok:" in r.stdout, r.stderr
-    world = load_scene(path)
+    scene = read_scene(path)
+    world = scene.world
     steps = SHORT_RUN.get(path.stem, DEFAULT_STEPS)
-    dt = world.scene.timestep
+    dt = scene.timestep
     out = tmp_path / "t.csv"
     r = ballpit("simulate", path, "--duration", repr(steps * dt), "--out", out)
     assert r.returncode == 0, r.stderr
@@ -178,6 +179,8 @@ def test_slopes_scene_layout():
     tilts = {round(math.degrees(math.acos(p.normal[1])), 3) for p in slopes}
     normals = {tuple(np.round(p.normal, 6)) for p in slopes}
     assert len(tilts) == 4 and len(normals) == 4, "each tilted differently"
+    bounciness = {p.restitution for p in slopes}
+    assert len(bounciness) == 4, "each as bouncy as no other, so their colours differ"
     assert all(p.position[1] - 0.5 * p.size[0] > 0 for p in slopes), "slopes are above the ground"
     heights = world.spheres.positions[:, 1]
     assert len(heights) == 5 and heights.argmax() == 4, "the fifth ball starts highest"
@@ -244,7 +247,8 @@ def test_slopes_fifth_ball_flies_far_with_the_highest_spin(slopes_run):
 
 def test_slopes_everything_stays_on_screen(slopes_run):
     world, frames = slopes_run.world, slopes_run.frames
-    camera, look_at = world.scene.camera_position, world.scene.camera_look_at
+    look = read_scene(SCENES / "slopes.toml").appearance
+    camera, look_at = look.camera_position, look.camera_look_at
     centres = frames[:, :, 2:5].reshape(-1, 3)
     tangents, depth = project(centres, camera, look_at)
     half_v = math.tan(math.radians(Camera().fov_y_degrees / 2))  # the viewer's vertical field of view

@@ -23,6 +23,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .cli import OneLineParser, _count, _positive, one_line
+
 DT = 1 / 240
 RADIUS = 0.05
 SPACING = 0.11
@@ -163,14 +165,27 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
 
 
 def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float) -> Result | None:
-    """``measure_one`` in a fresh interpreter; None when it fails or runs out of time."""
-    cmd = [sys.executable, "-m", "ballpit.bench", "--one", engine, workload, str(n), str(steps)]
+    """``measure_one`` in a fresh interpreter; None (after one line on stderr) when it fails.
+
+    The child runs with ``-P``: the current directory is not put on its path, so a folder named
+    ``ballpit`` there (a clone, seen from the folder above it) cannot shadow the installed package.
+    """
+    cmd = [sys.executable, "-P", "-m", "ballpit.bench", "--one", engine, workload, str(n), str(steps)]
+    label = f"{engine} {workload} N={n}"
     try:
-        out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=True).stdout
-    except (subprocess.CalledProcessError, subprocess.TimeoutExpired) as exc:
-        print(f"  {engine} {workload} N={n}: failed ({type(exc).__name__})", file=sys.stderr)
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        print(f"ballpit bench: {label}: failed: no result within {timeout:g} s", file=sys.stderr)
         return None
-    return Result(**json.loads(out.strip().splitlines()[-1]))
+    try:
+        if done.returncode != 0:
+            raise ValueError
+        return Result(**json.loads(done.stdout.strip().splitlines()[-1]))
+    except (ValueError, IndexError, TypeError):
+        why = [line.strip() for line in done.stderr.splitlines() if line.strip()]
+        reason = one_line(why[-1], limit=300) if why else f"exit status {done.returncode}, no output"
+        print(f"ballpit bench: {label}: failed: {reason}", file=sys.stderr)
+        return None
 
 
 def _table(results: list[Result], reference: dict[tuple[str, int], Result]) -> str:
@@ -229,7 +244,7 @@ def _sizes(text: str) -> list[int]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="ballpit bench", description=__doc__.splitlines()[0])
+    parser = OneLineParser(prog="ballpit bench", description=__doc__.splitlines()[0])
     parser.add_argument(
         "--workload",
         choices=("free", "pile", "settled", "all"),
@@ -237,16 +252,18 @@ def main(argv: list[str] | None = None) -> int:
         help="free flight; a grid falling into a box (the pile forming); or a pile already at rest",
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
-    parser.add_argument("--steps", type=int, default=None, help="steps to time (default: 1 s of simulation)")
+    parser.add_argument(
+        "--steps", type=_count, default=None, help="steps to time (default: 1 s of simulation)"
+    )
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
     parser.add_argument(
         "--pybullet-up-to",
-        type=int,
+        type=_count,
         metavar="N",
         help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
     )
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
-    parser.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per measurement")
+    parser.add_argument("--timeout", type=_positive, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )
@@ -272,20 +289,22 @@ def main(argv: list[str] | None = None) -> int:
     print(f"ballpit bench: {machine}, {versions}, dt = 1/240 s, RK4, each row in its own process")
     results: list[Result] = []
     reference: dict[tuple[str, int], Result] = {}
+    failed = 0
+    print(_table([], {}), flush=True)  # the header; each row prints as it finishes
     for workload, n in plan:
         steps = args.steps or 240  # one simulated second
         with_pybullet = args.pybullet and (args.pybullet_up_to is None or n <= args.pybullet_up_to)
-        engines = ["ballpit"] + (["pybullet"] if with_pybullet else [])
+        # PyBullet first, so ballpit's row can show the ratio to it as soon as it is printed.
+        engines = (["pybullet"] if with_pybullet else []) + ["ballpit"]
         for engine in engines:
             r = run_isolated(engine, workload, n, steps, args.timeout)
             if r is None:
+                failed += 1
                 continue
             results.append(r)
             if engine == "pybullet":
                 reference[(workload, n)] = r
-            print(_table([r], {}).splitlines()[1], flush=True)
-    print()
-    print(_table(results, reference))
+            print(_table([r], reference).splitlines()[1], flush=True)
     for engine in ("ballpit", "pybullet"):
         settled = sorted(
             (r for r in results if r.engine == engine and r.workload == "settled"), key=lambda r: r.n
@@ -295,8 +314,11 @@ def main(argv: list[str] | None = None) -> int:
                 np.log([r.n for r in settled]), np.log([1 / r.steps_per_second for r in settled]), 1
             )[0]
             print(f"{engine}: log-log slope of step time against N in the settled pile: {slope:.2f}")
-    if args.plot:
+    if args.plot and results:
         _plot(results, args.plot)
+    if failed:
+        print(f"ballpit bench: {failed} of {failed + len(results)} measurements failed", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -10,21 +10,76 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
 
-COMMANDS = ("view", "check", "simulate", "render", "bench", "scenes")
+if TYPE_CHECKING:
+    from .physics import World
+
+COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse with a one-line error message (no usage block), still exit status 2."""
+class OneLineParser(argparse.ArgumentParser):
+    """argparse with a one-line error message (no usage block), still exit status 2.
 
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+    Subcommand parsers made by ``add_subparsers`` are of the same class. Control characters in the
+    message (an option value holding a newline or a terminal escape) are shown escaped.
+    """
+
+    def error(self, message: str) -> NoReturn:  # type: ignore[override]
+        text = one_line(message, limit=500)
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {text} (see '{self.prog} --help')\n")
+
+
+def one_line(text: str, limit: int | None = None) -> str:
+    """``text`` with control characters escaped (so it stays one line), shortened to ``limit`` if given."""
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP, raised in the main thread so that every cleanup runs (like KeyboardInterrupt)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+
+
+def _on_stop_signal(signum: int, frame: object) -> None:
+    """The first stop signal unwinds the run; any later one is ignored, so the cleanup finishes."""
+    for name in _STOP_SIGNALS:
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Terminated(signum)
+
+
+def _install_stop_handlers() -> dict[int, object]:
+    """Route SIGINT, SIGTERM and SIGHUP to _on_stop_signal; returns the handlers they had."""
+    previous: dict[int, object] = {}
+    for name in _STOP_SIGNALS:
+        signum = getattr(signal, name, None)
+        if signum is None or signal.getsignal(signum) == signal.SIG_IGN:  # e.g. nohup: keep ignoring
+            continue
+        try:
+            previous[signum] = signal.signal(signum, _on_stop_signal)
+        except ValueError:  # not the main thread: leave signals alone
+            break
+    return previous
+
+
+class UsageError(ValueError):
+    """A command line whose options are each fine but that cannot be run (a run of 10¹² steps)."""
 
 
 def _positive(text: str) -> float:
@@ -62,7 +117,7 @@ def _size(text: str) -> tuple[int, int]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    parser = _Parser(
+    parser = OneLineParser(
         prog="ballpit",
         description="Balls, slopes, spin and impacts: a physics sandbox with a viewer and a headless runner.",
         epilog="With no command, or just a scene file, ballpit opens the viewer.",
@@ -72,6 +127,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("view", help="open the viewer on SCENE (default: the bundled slopes demo)")
     p.add_argument("scene", nargs="?", help="a scene file, or a bundled scene's name")
+    p.add_argument(
+        "--replay",
+        type=Path,
+        metavar="FILE",
+        help="play a trajectory (.npz or .csv) written by 'simulate --out' or '--record'; "
+        "the scene gives the planes, radii and colours",
+    )
+    p.add_argument("--record", type=Path, metavar="FILE", help="when the window closes, write every step "
+                   "it showed to FILE (.npz or .csv, simulate's trajectory columns)")  # fmt: skip
     p.set_defaults(handler=_view)
 
     p = sub.add_parser("check", help="validate a scene file")
@@ -93,9 +157,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--integrator", choices=("euler", "rk2", "rk4"), help="override the scene's integrator")
     p.add_argument("--out", type=Path, metavar="FILE", help="trajectory file, .csv or .npz")
     p.add_argument("--events", type=Path, metavar="FILE", help="contact events file, .csv or .npz")
+    p.add_argument(
+        "--events-kind",
+        choices=("impacts", "all"),
+        default="impacts",
+        help="impacts (default): a row when a contact starts (a bounce, a collision, a landing), not "
+        "for each step it rests or rolls on; all: every contact of every step",
+    )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
+    p.add_argument("--plot", type=Path, metavar="FILE", help="plot kinetic, potential and total energy "
+                   "over time: .png, .svg or .pdf")  # fmt: skip
+    p.add_argument("--profile", action="store_true", help="print where the step's time went, stage by "
+                   "stage, with intervals, pairs and contacts per step")  # fmt: skip
     p.set_defaults(handler=_simulate)
+
+    p = sub.add_parser(
+        "compare",
+        help="run a scene under Euler, RK2 and RK4 and compare energy drift and end positions",
+        description="Run the scene under Euler, RK2 and RK4 (each from its initial state) and RK4 at a "
+        "quarter of the step as a reference; print each one's total-energy drift and how far its balls "
+        "end from the reference's.",
+    )
+    p.add_argument("scene", help="a scene file, or a bundled scene's name")
+    p.add_argument("--duration", type=_positive, metavar="S", help="seconds to simulate (default: the "
+                   "scene's [world] duration, else 10)")  # fmt: skip
+    p.add_argument(
+        "--dt", type=_positive, metavar="S", help="seconds per step (default: the scene's timestep)"
+    )
+    p.add_argument("--plot", type=Path, metavar="FILE", help="plot each integrator's total-energy drift "
+                   "over time: .png, .svg or .pdf")  # fmt: skip
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_compare)
 
     p = sub.add_parser("render", help="render a scene offscreen to a GIF or a folder of PNG frames")
     p.add_argument("scene", help="a scene file, or a bundled scene's name")
@@ -127,16 +220,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(args_list)
     from .scene import SceneError
-    from .writers import OutputError
+    from .writers import OutputError, OutputFailed
 
+    previous = _install_stop_handlers()
     try:
         return int(args.handler(args) or EXIT_OK)
-    except (SceneError, OutputError) as e:
-        print(f"ballpit: {e}", file=sys.stderr)
+    except (SceneError, OutputError, UsageError) as e:
+        print(f"ballpit: {one_line(str(e))}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OutputFailed as e:
+        print(f"ballpit: {one_line(str(e))}; nothing was written", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print("ballpit: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated as e:
+        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _looks_like_scene(arg: str) -> bool:
@@ -144,14 +247,14 @@ def _looks_like_scene(arg: str) -> bool:
 
 
 def _load(scene_arg: str):
-    from .scene import load_scene, resolve_scene_path
+    from .scene import read_scene, resolve_scene_path
 
-    return load_scene(resolve_scene_path(scene_arg))
+    return read_scene(resolve_scene_path(scene_arg))
 
 
 def _check(args: argparse.Namespace) -> int:
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     duration = f", suggested duration {info.duration:g} s" if info.duration else ""
     print(
         f"{info.path}: ok: {len(world.spheres)} balls, {len(world.planes)} planes, {world.integrator}, "
@@ -160,20 +263,51 @@ def _check(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+class StepTotals:
+    """Adds up ``World.profile`` after every step of a run (``simulate --profile``), passing the world
+    on to another observer (the energy plot) if there is one."""
+
+    def __init__(self, then: Callable[[World], None] | None) -> None:
+        from .physics.profile import RunProfile
+
+        self.totals = RunProfile()
+        self.then = then
+        self._started = False
+
+    def observe(self, world: World) -> None:
+        if self._started:  # the first call comes before the first step
+            self.totals.add(world.profile)
+        self._started = True
+        if self.then is not None:
+            self.then(world)
+
+
 def _simulate(args: argparse.Namespace) -> int:
-    from .simulate import format_summary, run
+    from .simulate import MAX_STEPS, format_summary, run, step_count
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
-    world = _load(args.scene)
-    info = world.scene
+    info = _load(args.scene)
+    world = info.world
     if args.integrator:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
     duration = args.duration or info.duration or 10.0
+    if not step_count(duration, dt) <= MAX_STEPS:
+        source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
+        raise UsageError(
+            f"{source}: {duration:g} s in steps of {dt:g} s is {step_count(duration, dt):.3g} steps; "
+            f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"
+        )
     if args.out is not None and args.events is not None and args.out.resolve() == args.events.resolve():
         raise OutputError(f"{args.out}: --out and --events must be different files")
     writers: list = []
     try:
+        from .plots import energy_plot  # opened first: a bad --plot path fails before the run
+
+        plot = energy_plot(
+            args.plot, f"{info.name}: energy ({world.integrator}, steps of {dt * 1000:.4g} ms)"
+        )
+        writers += [plot] if plot is not None else []
         trajectory = events = None
         if args.out is not None:
             trajectory = TrajectoryWriter(args.out, len(world.spheres))
@@ -181,15 +315,19 @@ def _simulate(args: argparse.Namespace) -> int:
         if args.events is not None:
             events = EventWriter(args.events)
             writers.append(events)
+        profile = StepTotals(plot.record if plot is not None else None) if args.profile else None
         try:
             summary = run(
                 world,
                 duration,
                 dt,
+                observe=profile.observe if profile is not None else plot.record if plot is not None else None,
                 every=args.every,
                 trajectory=trajectory,
                 events=events,
+                events_kind=args.events_kind,
                 progress=not args.quiet,
+                name=info.name,
             )
         except FloatingPointError as e:
             print(
@@ -207,18 +345,46 @@ def _simulate(args: argparse.Namespace) -> int:
             print(line)
         if trajectory is not None:
             print(f"  wrote {args.out} ({summary.records} records x {len(world.spheres)} balls)")
+        if plot is not None:
+            print(f"  wrote {args.plot} (energies at {len(plot.record)} times)")
+    if profile is not None:
+        print(f"step profile: mean per step over {profile.totals.steps} steps ({world.integrator})")
+        for line in profile.totals.lines():
+            print(f"  {line}")
         if events is not None:
-            print(f"  wrote {args.events} ({events.count} contacts)")
+            what = "impacts" if args.events_kind == "impacts" else "contacts"
+            print(f"  wrote {args.events} ({events.count} {what})")
     return EXIT_OK
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from .compare import main as compare_main
+
+    return compare_main(args)
 
 
 def _view(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
+    from .writers import check_output_path
 
-    path = None
+    if args.record is not None:
+        check_output_path(args.record, "--record")  # a bad path is a one-line error before a window opens
+    if args.record is not None and args.replay is not None:
+        raise UsageError("--record and --replay cannot be used together")
+    path = world = None
     if args.scene is not None:
         path = resolve_scene_path(args.scene)
-        _load(str(path))  # a bad scene gets its one-line error before a window opens
+        world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
+    trajectory = None
+    if args.replay is not None:
+        from .viewer.replay import TrajectoryError, read_trajectory
+
+        world = world if world is not None else _load("slopes").world
+        try:
+            trajectory = read_trajectory(args.replay, n_balls=len(world.spheres))
+        except TrajectoryError as e:
+            print(f"ballpit: {e}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     try:
         from .viewer.app import run
     except ImportError as e:
@@ -227,30 +393,86 @@ def _view(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_FAILED
-    return int(run(path) or EXIT_OK)
+    return int(run(path, trajectory=trajectory, record=args.record) or EXIT_OK)
 
 
 def _render(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
-    from .writers import OutputError
+    from .writers import OutputError, check_name_lengths
 
     path = resolve_scene_path(args.scene)
-    world = _load(str(path))
-    duration = args.duration or world.scene.duration or 10.0
+    duration = args.duration or _load(str(path)).duration or 10.0
     out = Path(args.out)
+    check_name_lengths(out, "--out")
     folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix
     if not folder and out.suffix.lower() not in (".gif", ".png"):
         raise OutputError(
             f"{args.out}: --out must be a .gif, a .png or a folder for frames, not {out.suffix!r}"
         )
+    _check_render_path(out, args.out, folder)
     try:
         from .viewer.render import render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
-    written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    created = _missing_folders(out if folder else out.parent)
+    before = _render_files(out, folder)
+    try:
+        written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    except BaseException:  # interrupted, stopped or failed: no frames or half-written file from this run
+        _remove_render_output(out, folder, before, created)
+        raise
     print(f"wrote {written or out}")
     return EXIT_OK
+
+
+def _check_render_path(out: Path, raw: str, folder: bool) -> None:
+    """OutputError unless ``out`` can be made: every existing part of its path up to it a folder."""
+    from .writers import OutputError
+
+    try:
+        for parent in (out, *out.parents) if folder else out.parents:
+            if parent.exists():
+                if not parent.is_dir():
+                    raise OutputError(f"{raw}: --out: {str(parent)!r} is a file, not a folder")
+                break
+    except OSError as e:
+        raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """The folders on the way to ``folder`` that do not exist yet, deepest first."""
+    return [p for p in (folder, *folder.parents) if not p.exists()]
+
+
+def _render_files(out: Path, folder: bool) -> dict[Path, tuple[int, int]]:
+    """The files a render to ``out`` writes that exist now, with their (mtime, inode)."""
+    files = sorted(out.glob("frame_*.png")) if folder and out.is_dir() else [out]
+    found = {}
+    for file in files:
+        try:
+            st = file.stat()
+        except OSError:
+            continue
+        found[file] = (st.st_mtime_ns, st.st_ino)
+    return found
+
+
+def _remove_render_output(
+    out: Path, folder: bool, before: dict[Path, tuple[int, int]], created: list[Path]
+) -> None:
+    """Remove what a stopped render wrote (files new or changed since ``before``) and the folders it made."""
+    for file, stamp in _render_files(out, folder).items():
+        if before.get(file) != stamp:
+            try:
+                file.unlink()
+            except OSError:
+                pass
+    for made in created:  # deepest first; only if empty
+        try:
+            made.rmdir()
+        except OSError:
+            break
 
 
 def _bench(argv: list[str]) -> int:

@@ -6,14 +6,15 @@ state arrays once per recorded step into the writers' buffers; nothing is create
 
 from __future__ import annotations
 
+import collections.abc
 import math
 import time as clock
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from tqdm import tqdm
 
-from .physics import World
+from .physics import DEFAULT_TIMESTEP, Contacts, World
 from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from .writers import EventWriter, TrajectoryWriter
 
@@ -52,29 +53,75 @@ class RunSummary:
         return self.steps / self.wall_time if self.wall_time > 0 else math.inf
 
 
-def inertias(world: World) -> np.ndarray:
-    """Each ball's moment of inertia (kg·m²), read once through the public views."""
-    return np.array([s.inertia for s in world.spheres], dtype=float)
+def energy(world: World) -> Energy:
+    """The world's kinetic (½mv² + ½Iω²) and gravitational potential (−m g·x) energy."""
+    return Energy(world.kinetic_energy(), 0.0 + world.potential_energy())  # 0.0 +: no '-0'
 
 
-def energy(world: World, inertia: np.ndarray | None = None) -> Energy:
-    """Kinetic (½mv² + ½Iω²) and gravitational potential (−m g·x) energy of every ball."""
-    balls = world.spheres
-    if len(balls) == 0:
-        return Energy(0.0, 0.0)
-    inertia = inertias(world) if inertia is None else inertia
-    m = balls.masses
-    v = balls.velocities
-    w = balls.angular_velocities
-    kinetic = 0.5 * float(m @ np.einsum("ij,ij->i", v, v)) + 0.5 * float(
-        inertia @ np.einsum("ij,ij->i", w, w)
-    )
-    potential = 0.0 - float(m @ (balls.positions @ world.gravity))  # 0.0 -: no '-0' without gravity
-    return Energy(kinetic, potential)
+ROUNDING = 64 * np.finfo(float).eps  # energies smaller than this times the run's scale print as 0
+
+
+def tidy(value: float, scale: float) -> float:
+    """``value``, or 0.0 when it is zero to within rounding next to ``scale`` (the run's energies)."""
+    return 0.0 if abs(value) <= ROUNDING * scale else value
+
+
+MAX_STEPS = 10**9  # a longer run is a mistake (a timestep of 1e-300 s), not a job: refused
+
+
+class TooManySteps(ValueError):
+    """A run of more than MAX_STEPS steps."""
+
+
+def step_count(duration: float, dt: float) -> float:
+    """How many steps ``duration`` takes at ``dt`` (a float: it may be astronomically large, or inf)."""
+    return math.ceil(duration / dt - 1e-9) if duration / dt < 2.0**62 else duration / dt
+
+
+EVENT_KINDS = ("impacts", "all")
+
+
+class ImpactFilter:
+    """Keeps, of each step's contacts, the impacts: pairs that were not in contact the step before.
+
+    A bounce, a collision, a ball landing or rolling onto another plane is the first step of a
+    contact, and is kept; the same pair resting or rolling on in the following steps is not. A
+    contact that opens and closes again (a ball bouncing, or jostled in a pile) is kept each time it
+    closes. Contacts present when the run starts count in its first step.
+    """
+
+    def __init__(self) -> None:
+        self._previous = np.zeros(0, dtype=np.int64)  # sorted pair keys of the last step
+
+    def __call__(self, contacts: Contacts) -> Contacts:
+        """The impacts among one step's ``contacts``; call it once per step, in order."""
+        keys = _pair_keys(contacts)
+        previous = self._previous
+        self._previous = np.sort(keys)
+        if len(previous) == 0 or len(keys) == 0:
+            return contacts
+        at = np.minimum(np.searchsorted(previous, keys), len(previous) - 1)
+        seen = previous[at] == keys
+        if not seen.any():
+            return contacts
+        return Contacts(**{f.name: getattr(contacts, f.name)[~seen] for f in fields(Contacts)})
+
+
+def _pair_keys(contacts: Contacts) -> np.ndarray:
+    """One integer per (kind, a, b) pair (ball and plane indices are below 2**30)."""
+    return ((contacts.a.astype(np.int64) * 2 + contacts.kind) << 32) | contacts.b.astype(np.int64)
 
 
 def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
-    """Steps as (count, dt) runs that end exactly at ``duration``: whole steps, then any remainder."""
+    """Steps as (count, dt) runs that end exactly at ``duration``: whole steps, then any remainder.
+
+    Raises TooManySteps for a run of more than MAX_STEPS steps.
+    """
+    count = step_count(duration, dt)
+    if not count <= MAX_STEPS:
+        raise TooManySteps(
+            f"{duration:g} s in steps of {dt:g} s is {count:.3g} steps; the limit is {MAX_STEPS:.0e}"
+        )
     whole = math.floor(duration / dt + 1e-9)
     rest = duration - whole * dt
     plan = [(whole, dt)] if whole else []
@@ -83,28 +130,47 @@ def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
     return plan
 
 
+def progress_bar(total: int, name: str, progress: bool) -> tqdm:
+    """The steps' progress bar on stderr: only on a terminal, after a second, gone when done."""
+    return tqdm(
+        total=total,
+        unit="step",
+        disable=None if progress else True,  # None: only on a terminal
+        delay=1.0,
+        leave=False,
+        dynamic_ncols=True,
+        desc=name,
+    )
+
+
 def run(
     world: World,
     duration: float,
     dt: float | None = None,
     *,
+    observe: collections.abc.Callable[[World], None] | None = None,  # called at the start and after each step
     every: int = 1,
     trajectory: TrajectoryWriter | None = None,
     events: EventWriter | None = None,
+    events_kind: str = "impacts",
     progress: bool = False,
+    name: str = "simulate",
 ) -> RunSummary:
     """Advance ``world`` by ``duration`` seconds in steps of ``dt``, recording every ``every``-th step.
 
-    The trajectory gets the initial state, every ``every``-th step and the final state. The writers
-    are not committed here; the caller commits them on success or discards them on failure.
+    ``dt`` defaults to the physics' default timestep; ``name`` labels the progress bar. The trajectory
+    gets the initial state, every ``every``-th step and the final state. ``events`` gets the impacts
+    (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step. The writers are
+    not committed here; the caller commits them on success or discards them on failure.
     """
-    scene = getattr(world, "scene", None)
-    dt = dt if dt is not None else (scene.timestep if scene is not None else 1.0 / 240.0)
+    if events_kind not in EVENT_KINDS:
+        raise ValueError(f"events_kind must be one of {', '.join(EVENT_KINDS)}, got {events_kind!r}")
+    keep = ImpactFilter() if events is not None and events_kind == "impacts" else None
+    dt = dt if dt is not None else DEFAULT_TIMESTEP
     plan = step_plan(duration, dt)
     total = sum(n for n, _ in plan)
     balls = world.spheres
-    inertia = inertias(world)
-    start_energy = energy(world, inertia)
+    start_energy = energy(world)
 
     def record() -> None:
         if trajectory is not None:
@@ -113,17 +179,11 @@ def run(
             )
 
     record()
+    if observe is not None:
+        observe(world)
     counts = np.zeros(2, dtype=np.int64)
     done = 0
-    bar = tqdm(
-        total=total,
-        unit="step",
-        disable=None if progress else True,  # None: only on a terminal
-        delay=1.0,
-        leave=False,
-        dynamic_ncols=True,
-        desc=getattr(scene, "name", "simulate"),
-    )
+    bar = progress_bar(total, name, progress)
     began = clock.perf_counter()
     try:
         for n, h in plan:
@@ -132,11 +192,13 @@ def run(
                 done += 1
                 if len(contacts):
                     counts += np.bincount(contacts.kind, minlength=2)[:2]
-                    if events is not None:
-                        events.add(contacts)
+                if events is not None:
+                    events.add(contacts if keep is None else keep(contacts))
                 if done % every == 0 or done == total:
                     record()
                 bar.update()  # cheap next to a step; tqdm redraws at most ~10 times a second
+                if observe is not None:
+                    observe(world)
     finally:
         bar.close()
     wall = clock.perf_counter() - began
@@ -148,7 +210,7 @@ def run(
         sphere_sphere_contacts=int(counts[SPHERE_SPHERE]),
         records=trajectory.records if trajectory is not None else 0,
         energy_start=start_energy,
-        energy_end=energy(world, inertia),
+        energy_end=energy(world),
     )
 
 
@@ -156,13 +218,18 @@ def format_summary(summary: RunSummary, name: str, integrator: str, dt: float, n
     """The closing summary, a few short lines."""
     s = summary
     e0, e1 = s.energy_start, s.energy_end
+    scale = max(abs(e.kinetic) + abs(e.potential) for e in (e0, e1))
+
+    def j(value: float) -> str:
+        return f"{tidy(value, scale):.6g}"
+
     lines = [
         f"{name}: {n_balls} balls, {s.steps} steps of {dt * 1000:.4g} ms "
         f"({s.sim_time:g} s simulated, {integrator})",
         f"  wall time {s.wall_time:.3f} s, {s.steps_per_second:,.0f} steps/s",
         f"  contacts {s.contacts} "
         f"({s.sphere_plane_contacts} sphere-plane, {s.sphere_sphere_contacts} sphere-sphere)",
-        f"  energy start {e0.total:.6g} J (kinetic {e0.kinetic:.6g} + potential {e0.potential:.6g}), "
-        f"end {e1.total:.6g} J (kinetic {e1.kinetic:.6g} + potential {e1.potential:.6g})",
+        f"  energy start {j(e0.total)} J (kinetic {j(e0.kinetic)} + potential {j(e0.potential)}), "
+        f"end {j(e1.total)} J (kinetic {j(e1.kinetic)} + potential {j(e1.potential)})",
     ]
     return lines

@@ -2,12 +2,19 @@
 
 Each writer fills a temporary file beside its target and renames it into place only when the run
 finishes, so a crash, a Ctrl+C or a bad option never leaves a truncated file that looks complete.
-Rows are buffered as arrays and formatted a chunk at a time with one ``%`` operation, not per row.
+Rows are buffered as arrays a chunk at a time and streamed to disk as the run goes, so memory does not
+grow with the duration: CSV text is formatted a chunk at a time with one ``%`` operation, not per row;
+for ``.npz``, each chunk's columns go to an unnamed scratch file, and ``commit`` copies them column by
+column into the archive's ``.npy`` members, a chunk at a time.
 """
 
 from __future__ import annotations
 
 import os
+import tempfile
+import zipfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
@@ -27,17 +34,62 @@ class OutputError(ValueError):
     """An output path that cannot be written (bad suffix, missing directory, no permission)."""
 
 
+class OutputFailed(Exception):
+    """Writing an output failed part way (a full disk, a file size limit, an I/O error)."""
+
+
+@contextmanager
+def _writing(path: Path) -> Iterator[None]:
+    """Turn an OSError while writing ``path`` into OutputFailed naming the file and the reason."""
+    try:
+        yield
+    except OSError as e:
+        raise OutputFailed(f"{shorten(path)}: cannot write: {e.strerror or e}") from e
+
+
+NAME_MAX = 255  # bytes in one file name on Linux, macOS and Windows file systems
+_TEMP_NAME = ".{name}.{pid}.partial"
+
+
+def shorten(path: Path | str, limit: int = 80) -> str:
+    """``path`` for a message: kept whole when short, else its start and end around an ellipsis."""
+    text = str(path)
+    return text if len(text) <= limit else f"{text[: limit // 2 - 2]}...{text[-(limit // 2 - 1) :]}"
+
+
+def check_name_lengths(path: Path, what: str) -> None:
+    """OutputError if a part of ``path`` is longer than a file name can be (NAME_MAX bytes)."""
+    for part in path.parts:
+        size = len(os.fsencode(part))
+        if size > NAME_MAX:
+            raise OutputError(
+                f"{shorten(path)}: {what}: a file name of {size} bytes is too long; the limit is {NAME_MAX}"
+            )
+
+
 def check_output_path(path: Path, what: str) -> str:
     """The output format (".csv" or ".npz") for ``path``, or OutputError saying what is wrong."""
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"{path}: {what} must end in .csv or .npz, not {suffix or 'no suffix'!r}")
-    if path.is_dir():
-        raise OutputError(f"{path}: {what} is a directory")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
+    check_name_lengths(path, what)
+    try:
+        if path.is_dir():
+            raise OutputError(f"{path}: {what} is a directory")
+        parent = path.parent if str(path.parent) else Path(".")
+        if not parent.is_dir():
+            raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
+    except OSError as e:
+        raise OutputError(f"{shorten(path)}: {what}: {e.strerror or e}") from None
     return suffix
+
+
+def temp_path(target: Path) -> Path:
+    """A hidden temporary name beside ``target`` (its name shortened if need be to fit NAME_MAX)."""
+    name, pid = target.name, os.getpid()
+    while len(os.fsencode(_TEMP_NAME.format(name=name, pid=pid))) > NAME_MAX:
+        name = name[:-1]
+    return target.with_name(_TEMP_NAME.format(name=name, pid=pid))
 
 
 class AtomicFile:
@@ -45,7 +97,7 @@ class AtomicFile:
 
     def __init__(self, target: Path, mode: str = "w") -> None:
         self.target = target
-        self.temp = target.with_name(f".{target.name}.{os.getpid()}.partial")
+        self.temp = temp_path(target)
         try:
             self.file: IO = open(self.temp, mode, encoding="utf-8" if "b" not in mode else None)
         except OSError as e:
@@ -56,33 +108,162 @@ class AtomicFile:
         os.replace(self.temp, self.target)
 
     def discard(self) -> None:
-        self.file.close()
-        self.temp.unlink(missing_ok=True)
+        """Remove the temporary file, even when closing it fails (a full disk fails the last flush)."""
+        try:
+            self.file.close()
+        except OSError:
+            pass
+        finally:
+            self.temp.unlink(missing_ok=True)
 
 
-class TrajectoryWriter:
-    """Every ball's state at the recorded times: one row per ball per record.
+class ColumnSpool:
+    """Rows of float64 columns spooled to an unnamed scratch file, written out as ``.npy`` members.
 
-    ``record`` copies the state into a preallocated buffer; full buffers are flushed as CSV text, or
-    kept as arrays for one ``.npz`` at the end.
+    Each chunk is stored column after column, so a column can be read back a chunk at a time. The
+    scratch file has no name (it is deleted as soon as it is made, or made without one), so nothing
+    of it can be left behind, whatever ends the process.
     """
 
-    def __init__(self, path: Path, n_balls: int) -> None:
+    def __init__(self, names: tuple[str, ...], directory: Path) -> None:
+        self.names = names
+        try:
+            self.file = tempfile.TemporaryFile(dir=directory)
+        except OSError as e:
+            raise OutputError(
+                f"{shorten(directory)}: cannot write a scratch file: {e.strerror or e}"
+            ) from None
+        self.chunks: list[tuple[int, int]] = []  # (byte offset, rows)
+        self.rows = 0
+
+    def add(self, rows: np.ndarray) -> None:
+        """Append (R, len(names)) rows."""
+        if len(rows) == 0:
+            return
+        self.chunks.append((self.file.tell(), len(rows)))
+        self.file.write(np.ascontiguousarray(rows.T, dtype=np.float64).data)  # a full disk: ENOSPC
+        self.rows += len(rows)
+
+    def truncate(self, chunks: int) -> None:
+        """Keep only the first ``chunks`` chunks (the rest of the scratch file is cut off)."""
+        if chunks >= len(self.chunks):
+            return
+        offset = self.chunks[chunks][0]
+        self.rows -= sum(rows for _, rows in self.chunks[chunks:])
+        del self.chunks[chunks:]
+        self.file.truncate(offset)
+        self.file.seek(offset)
+
+    def column(self, k: int):
+        """Column ``k``, one chunk at a time."""
+        for offset, rows in self.chunks:
+            self.file.seek(offset + k * rows * 8)
+            chunk = np.empty(rows, dtype=np.float64)
+            if self.file.readinto(chunk.data.cast("B")) != chunk.nbytes:
+                raise OSError(f"the scratch file ended early, in column {self.names[k]!r}")
+            yield chunk
+
+    def write_npz(self, out: IO[bytes], convert: dict[str, tuple[np.dtype, Callable]]) -> None:
+        """Write every column to ``out`` as ``np.savez`` would (one stored ``<name>.npy`` member each).
+
+        ``convert`` gives a column's dtype and a function from float64 chunk to that dtype.
+        """
+        self.file.flush()
+        with zipfile.ZipFile(out, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as archive:
+            for k, name in enumerate(self.names):
+                dtype, cast = convert.get(name, (np.dtype(np.float64), None))
+                header = np.lib.format.header_data_from_array_1_0(np.empty(0, dtype))
+                header["shape"] = (self.rows,)
+                with archive.open(f"{name}.npy", "w", force_zip64=True) as member:  # as np.savez does
+                    np.lib.format.write_array_header_1_0(member, header)
+                    for chunk in self.column(k):
+                        member.write((chunk if cast is None else cast(chunk)).astype(dtype).tobytes())
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def _directory(path: Path) -> Path:
+    return path.parent if str(path.parent) else Path(".")
+
+
+_TRAJECTORY_TYPES = {"id": (np.dtype(np.int64), None)}
+_EVENT_TYPES = {
+    "kind": (
+        np.dtype(f"<U{max(map(len, KIND_NAMES))}"),
+        lambda code: np.asarray(KIND_NAMES)[code.astype(np.intp)],
+    ),
+    "a": (np.dtype(np.int64), None),
+    "b": (np.dtype(np.int64), None),
+}
+
+
+class _SpooledOutput:
+    """Commit or discard for a writer whose rows go to ``out`` (CSV text) or ``spool`` (.npz columns,
+    typed by ``types`` when the archive is written)."""
+
+    path: Path
+    out: AtomicFile
+    spool: ColumnSpool | None
+    types: dict
+
+    def _flush(self) -> None:
+        raise NotImplementedError
+
+    def commit(self) -> None:
+        self._flush()
+        with _writing(self.path):
+            if self.spool is not None:
+                self.spool.write_npz(self.out.file, self.types)
+                self.spool.close()
+            self.out.commit()
+
+    def discard(self) -> None:
+        try:
+            if self.spool is not None:
+                self.spool.close()
+        finally:
+            self.out.discard()
+
+
+class TrajectoryWriter(_SpooledOutput):
+    """Every ball's state at the recorded times: one row per ball per record.
+
+    ``record`` copies the state into a preallocated buffer; full buffers go to disk as CSV text, or
+    to the ``.npz``'s column spool. The number of balls may change between records (the viewer adds
+    balls): ball ``i`` is always id ``i``, and new balls get the next ids.
+    """
+
+    types = _TRAJECTORY_TYPES
+
+    def __init__(
+        self, path: Path, n_balls: int, option: str = "--out", records_per_chunk: int | None = None
+    ) -> None:
         self.path = path
-        self.format = check_output_path(path, "--out")
-        self.n = n_balls
-        self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
-        self.records_per_chunk = max(1, _CHUNK_ROWS // max(1, n_balls))
-        self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
-        self.buffer[:, :, 1] = np.arange(n_balls)
-        self.filled = 0
+        self.format = check_output_path(path, option)
+        self.chunk_records = records_per_chunk  # 1: every record is its own chunk, so it can be cut off
+        self._marks: list[int] = []  # where each chunk begins: a byte offset (.csv) or spool chunk (.npz)
+        self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
+        self.out = AtomicFile(
+            path, "w" if self.format == ".csv" else "wb"
+        )  # after the spool: its error leaves nothing
+        self._allocate(n_balls)
         self.records = 0
-        self.chunks: list[np.ndarray] = []
         self.row_format = ",".join(["%.9g", "%d"] + [_FLOAT] * (len(TRAJECTORY_COLUMNS) - 2)) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(TRAJECTORY_COLUMNS) + "\n")
 
+    def _allocate(self, n_balls: int) -> None:
+        self.n = n_balls
+        self.records_per_chunk = self.chunk_records or max(1, _CHUNK_ROWS // max(1, n_balls))
+        self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
+        self.buffer[:, :, 1] = np.arange(n_balls)
+        self.filled = 0
+
     def record(self, time: float, position, velocity, angular_velocity, orientation) -> None:
+        if len(position) != self.n:  # balls were added: rows of the new count from here on
+            self._flush()
+            self._allocate(len(position))
         row = self.buffer[self.filled]
         row[:, 0] = time
         row[:, 2:5] = position
@@ -95,36 +276,52 @@ class TrajectoryWriter:
             self._flush()
 
     def _flush(self) -> None:
+        if self.filled == 0:
+            return
         rows = self.buffer[: self.filled].reshape(-1, len(TRAJECTORY_COLUMNS))
-        if self.format == ".csv":
-            self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
-        else:
-            self.chunks.append(rows.copy())
+        with _writing(self.path):
+            if self.spool is None:
+                self._marks.append(self.out.file.tell())
+                self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
+            else:
+                self._marks.append(len(self.spool.chunks))
+                self.spool.add(rows)
         self.filled = 0
 
-    def commit(self) -> None:
-        self._flush()
-        if self.format == ".npz":
-            rows = np.concatenate(self.chunks) if self.chunks else np.zeros((0, len(TRAJECTORY_COLUMNS)))
-            arrays = {name: rows[:, k] for k, name in enumerate(TRAJECTORY_COLUMNS)}
-            arrays["id"] = arrays["id"].astype(np.int64)
-            np.savez(self.out.file, **arrays)
-        self.out.commit()
+    def truncate(self, records: int) -> None:
+        """Keep only the first ``records`` records (the viewer resuming from the past drops its future).
+        Records already written can be cut off only when each is its own chunk (``records_per_chunk=1``)."""
+        if records >= self.records:
+            return
+        written = self.records - self.filled
+        if records >= written:  # still in the buffer
+            self.filled = records - written
+        else:
+            if self.chunk_records != 1:
+                raise ValueError("records already written can be cut off only with records_per_chunk=1")
+            self._flush()
+            mark = self._marks[records]
+            del self._marks[records:]
+            if self.spool is None:
+                self.out.file.truncate(mark)
+                self.out.file.seek(mark)
+            else:
+                self.spool.truncate(mark)
+        self.records = records
 
-    def discard(self) -> None:
-        self.out.discard()
 
-
-class EventWriter:
+class EventWriter(_SpooledOutput):
     """Every contact the solver resolved: time, kind, the two bodies, point, normal and impulse."""
+
+    types = _EVENT_TYPES
 
     def __init__(self, path: Path) -> None:
         self.path = path
         self.format = check_output_path(path, "--events")
+        self.spool = ColumnSpool(EVENT_COLUMNS, _directory(path)) if self.format == ".npz" else None
         self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
         self.pending: list[Contacts] = []
         self.pending_rows = 0
-        self.chunks: list[Contacts] = []
         self.count = 0
         self.row_format = ",".join(["%.9g", "%s", "%d", "%d"] + [_FLOAT] * 7) + "\n"
         if self.format == ".csv":
@@ -144,8 +341,20 @@ class EventWriter:
             return
         c = Contacts.concatenate(self.pending)
         self.pending, self.pending_rows = [], 0
-        if self.format == ".npz":
-            self.chunks.append(c)
+        with _writing(self.path):
+            self._write(c)
+
+    def _write(self, c: Contacts) -> None:
+        if self.spool is not None:
+            rows = np.empty((len(c), len(EVENT_COLUMNS)))
+            rows[:, 0] = c.time
+            rows[:, 1] = c.kind
+            rows[:, 2] = c.a
+            rows[:, 3] = c.b
+            rows[:, 4:7] = c.point
+            rows[:, 7:10] = c.normal
+            rows[:, 10] = c.impulse
+            self.spool.add(rows)
             return
         rows = np.empty((len(c), len(EVENT_COLUMNS)), dtype=object)
         rows[:, 0] = c.time
@@ -156,26 +365,3 @@ class EventWriter:
         rows[:, 7:10] = c.normal
         rows[:, 10] = c.impulse
         self.out.file.write((self.row_format * len(c)) % tuple(rows.ravel().tolist()))
-
-    def commit(self) -> None:
-        self._flush()
-        if self.format == ".npz":
-            c = Contacts.concatenate(self.chunks)
-            np.savez(
-                self.out.file,
-                time=c.time,
-                kind=np.asarray(KIND_NAMES)[c.kind],
-                a=c.a.astype(np.int64),
-                b=c.b.astype(np.int64),
-                x=c.point[:, 0],
-                y=c.point[:, 1],
-                z=c.point[:, 2],
-                nx=c.normal[:, 0],
-                ny=c.normal[:, 1],
-                nz=c.normal[:, 2],
-                impulse=c.impulse,
-            )
-        self.out.commit()
-
-    def discard(self) -> None:
-        self.out.discard()

@@ -71,3 +71,17 @@ def test_sphere_plane_pairs_find_boxes_near_the_rectangle_only() -> None:
     s, p = broadphase.sphere_plane_pairs(lo, hi, centre, normal, axis_u, axis_v, np.array([[1.0, 1.0]]))
     assert s.tolist() == [0]
     assert p.tolist() == [0]
+
+
+@pytest.mark.parametrize("n", [2, 5, 30, 48, 49, 60])
+def test_few_boxes_give_the_same_pairs_in_the_same_order_either_way(n):
+    # Up to ALL_PAIRS_UP_TO boxes every pair is tested at once; above it the grid is used. Either way
+    # the pairs are the brute-force ones, ordered by i then j, so a step gives identical results.
+    rng = np.random.default_rng(n)
+    centre = rng.uniform(0, 1.5, (n, 3))
+    half = rng.uniform(0.05, 0.3, (n, 1))
+    lo, hi = centre - half, centre + half
+    i, j = broadphase.sphere_pairs(lo, hi)
+    bi, bj = np.triu_indices(n, 1)
+    keep = np.all((lo[bi] <= hi[bj]) & (lo[bj] <= hi[bi]), axis=1)
+    assert np.array_equal(i, bi[keep]) and np.array_equal(j, bj[keep])

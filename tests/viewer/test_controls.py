@@ -105,6 +105,28 @@ def test_escape_releases_a_captured_mouse_and_quits_only_when_pressed_again():
 def test_help_lists_every_control_of_the_design_table():
     keys = " ".join(k for k, _ in controls.HELP)
     for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1 / 2 / 3", "+ / −", "W A S D", "Q E",
-                  "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12"):  # fmt: skip
+                  "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12", "←", "Shift+←", "G", "P"):  # fmt: skip
         assert label in keys, label
     assert "scroll" in " ".join(w for _, w in controls.HELP)
+
+
+def test_arrows_move_through_the_history_and_g_p_toggle_ghosts_and_plot():
+    assert controls.action_for_key("LEFT") is Action.STEP_BACK
+    assert controls.action_for_key("RIGHT") is Action.STEP
+    assert controls.action_for_key("LEFT", shift=True) is Action.JUMP_BACK
+    assert controls.action_for_key("RIGHT", shift=True) is Action.JUMP_FORWARD
+    assert controls.action_for_key("G") is Action.GHOSTS
+    assert controls.action_for_key("P") is Action.ENERGY_PLOT
+    assert controls.action_for_key("X", shift=True) is Action.START  # Shift only changes the arrows
+
+
+def test_reaching_in_keys_shoot_change_the_shot_speed_go_home_and_save():
+    assert action_for_key("B") is Action.SHOOT
+    assert action_for_key("B", shift=True) is Action.SHOT_SPEED
+    assert action_for_key("HOME") is Action.HOME
+    assert action_for_key("S", ctrl=True) is Action.SAVE
+    assert action_for_key("S") is None and "S" in controls.FLY_KEYS  # plain S still flies back
+    assert action_for_key("X", shift=True) is Action.START  # Shift changes only what it is bound for
+    keys = " ".join(k for k, _ in controls.HELP)
+    for label in ("left-drag", "B / Shift+B", "click a plane", "Home", "Ctrl+S"):
+        assert label in keys, label

@@ -82,21 +82,19 @@ def test_a_turning_paddle_is_drawn_turning(offscreen):
 def test_planes_are_drawn_at_the_moment_the_balls_are_drawn(offscreen):
     """Balls are drawn interpolated between the last two steps; a moving plane is drawn at the same
     moment (its pose moved back along its motion), so a ball riding it does not sink into it."""
-    from ballpit.viewer.frame import plane_poses  # after the offscreen fixture chose the GL loader
-
     sim = plate(velocity=(0, 2.0, 0), angular_velocity=(0, 0, 1.0))
     sim.start()
     dt = sim.timestep
     sim.advance(2.5 * dt)  # two steps taken, half a step in the accumulator
     assert sim.alpha == pytest.approx(0.5)
-    centers, orientations = plane_poses(sim)
+    centers, orientations = sim.render_planes()
     # the balls are drawn halfway between step 1 and step 2, at 1.5 dt: so is the plane
     shown = 1.5 * dt
     assert centers[0] == pytest.approx([0, 2.0 * shown, 0])
     q = orientations[0]
     assert 2 * math.atan2(q[2], q[3]) == pytest.approx(1.0 * shown)  # a turn about z
     sim.toggle_pause()  # paused: drawn where they are
-    centers, _ = plane_poses(sim)
+    centers, _ = sim.render_planes()
     assert centers[0] == pytest.approx(sim.world.planes[0].position)
 
 
@@ -107,12 +105,15 @@ def test_ballpit_render_draws_a_moving_plane_where_it_is(tmp_path):
 
     world = ballpit.World(gravity=(0, 0, 0))
     world.add_plane(position=(0, 0, 0), normal=(0, 0, 1), size=(2.0, 0.4), velocity=(0, 1.0, 0))
+    look = Simulation(
+        world
+    ).appearance  # the camera render uses for a world built in code, framed before it moves
+    camera = Camera.looking_at(look.camera_position, look.camera_look_at)
     out = render_world(world, tmp_path / "frames/", duration=1.0, fps=10, size=(200, 150), progress=False)
     from PIL import Image
 
     frames = sorted(out.glob("frame_*.png"))
     assert len(frames) == 10
-    camera = Camera.looking_at((0.0, 4.0, 12.0), (0.0, 2.0, 0.0))  # the default camera of a coded world
 
     def lit(image: np.ndarray, point) -> bool:
         (x, y), _ = camera.project(np.asarray(point, float), 200, 150)

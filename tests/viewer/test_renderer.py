@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.viewer.appearance import restitution_colors
+from ballpit.scene.colours import restitution_colors
 from ballpit.viewer.camera import Camera
 from ballpit.viewer.simulation import Simulation
 

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.scene import read_scene
 from ballpit.viewer.simulation import MAX_FRAME_SECONDS, Phase, Simulation
 
 from .conftest import line_of_balls
@@ -167,7 +168,7 @@ def test_trails_keep_recent_positions_oldest_first_within_a_budget():
 def test_scene_settings_come_from_the_scene_file(tmp_path):
     path = tmp_path / "good.toml"
     path.write_text(GOOD_SCENE)
-    sim = Simulation(ballpit.load_scene(path), path)
+    sim = Simulation(read_scene(path))
     assert sim.timestep == 0.005
     assert sim.appearance.name == "good.toml"
     assert np.allclose(sim.appearance.camera_position, [1, 3, 9])
@@ -177,7 +178,7 @@ def test_scene_settings_come_from_the_scene_file(tmp_path):
 def test_a_broken_reload_keeps_the_last_good_world_and_reports_the_error(tmp_path, capsys):
     path = tmp_path / "scene.toml"
     path.write_text(GOOD_SCENE)
-    sim = Simulation(ballpit.load_scene(path), path)
+    sim = Simulation(read_scene(path))
     sim.start()
     sim.advance(0.1)
     world = sim.world
@@ -192,7 +193,7 @@ def test_a_broken_reload_keeps_the_last_good_world_and_reports_the_error(tmp_pat
 def test_saving_the_file_is_noticed_and_a_good_reload_replaces_the_world(tmp_path):
     path = tmp_path / "scene.toml"
     path.write_text(GOOD_SCENE)
-    sim = Simulation(ballpit.load_scene(path), path)
+    sim = Simulation(read_scene(path))
     generation = sim.generation
     assert not sim.file_changed()
     path.write_text(GOOD_SCENE + "\n[[sphere]]\nposition = [1, 3, 0]\n")

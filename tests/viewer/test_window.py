@@ -94,7 +94,8 @@ def test_integrator_time_scale_overlay_hud_help_screenshot_and_escape_keys(xvfb,
     assert [r["integrator_1"], r["integrator_2"], r["integrator_3"]] == ["euler", "rk2", "rk4"]
     assert r["faster"] == 2.0 and r["slower"] == 0.5
     assert r["overlays"] == [True, True, True]
-    assert r["draw_labels"] == ["planes", "balls", "world lines", "overlay lines"]
+    # after the drop the timeline bar is drawn last, in the screen-space pass
+    assert r["draw_labels"] == ["planes", "balls", "world lines", "overlay lines", "screen panels"]
     assert r["hud_hidden"] and r["help_shown"]
     shot = Path(r["screenshot"])
     assert shot.parent == tmp_path / "screenshots" and shot.suffix == ".png" and shot.stat().st_size > 1000
@@ -243,3 +244,20 @@ def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
         assert len(lines) == 1, proc.stderr
         assert "no display" in lines[0] and "ballpit render SCENE --out demo.gif" in lines[0]
         assert "xvfb-run ballpit" in lines[0]
+
+
+def test_f2_shows_the_time_of_each_stage_of_the_step_and_f2_again_goes_back(xvfb, tmp_path):
+    from ballpit.physics.profile import STAGES
+
+    result = run_scenario(xvfb, "profile_page", tmp_path)
+    text = result["profile"]
+    ms = {}
+    for line in text.splitlines():
+        match = re.fullmatch(r"(.+?)\s+(\d+\.\d+) ms", line)
+        if match:
+            ms[match.group(1).strip()] = float(match.group(2))
+    assert set(STAGES) <= set(ms), text
+    assert ms["step"] > 0 and sum(ms[s] for s in STAGES) <= ms["step"] * 1.01 + 0.002, text
+    steps = int(re.search(r"step profile, (\d+) steps", text).group(1))
+    assert steps > 0 and re.search(r"intervals/step \d+\.\d+", text)
+    assert result["page"] == "stats" and "sim time" in result["back"]

@@ -414,6 +414,19 @@ def double_escape(workdir: Path) -> dict:
     return out
 
 
+def profile_page(workdir: Path) -> dict:
+    """F2 shows where the step's time goes, stage by stage; F2 again goes back to the HUD."""
+    viewer = open_viewer(world=balls_world())
+    press(viewer, "X")
+    pump(viewer, 90)  # the balls land on the slope and the floor
+    press(viewer, "F2")
+    pump_until(viewer, lambda: "step profile," in viewer.hud.text)
+    profile = viewer.hud.text
+    press(viewer, "F2")
+    pump_until(viewer, lambda: "sim time" in viewer.hud.text)
+    return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page}
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
@@ -427,6 +440,7 @@ SCENARIOS = {
         slopes_framing,
         help_beside_hud,
         double_escape,
+        profile_page,
     )
 }
 

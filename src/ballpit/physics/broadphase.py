@@ -51,12 +51,20 @@ def within_reach(
     return i[keep], j[keep]
 
 
+# Up to this many boxes, testing every pair at once costs fewer array operations than the grid.
+ALL_PAIRS_UP_TO = 48
+
+
 def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs (i < j) of boxes that overlap."""
+    """All pairs (i < j) of boxes that overlap, ordered by i, then j."""
     n = len(lo)
     if n < 2:
         empty = np.zeros(0, np.intp)
         return empty, empty
+    if n <= ALL_PAIRS_UP_TO:  # a handful of balls: every pair in one go, already in order
+        i, j = np.triu_indices(n, 1)
+        hit = _overlap(lo, hi, i, j)
+        return i[hit], j[hit]
     extent = (hi - lo).max(axis=1)
     # The smallest cell that still holds every box keeps the fewest boxes per cell to test: in a packed
     # pile, a cell of twice the median box would hold ~8× as many.

@@ -1,8 +1,10 @@
 """Penetration removal: overlapping balls are moved apart, by positions only.
 
-No velocity is added, so removing an overlap never launches a ball (design.md). Each overlapping
-contact's linearised gap g = n·(x_a − x_b) − offset is driven to zero by a few Gauss–Seidel sweeps
-over the contact colours, each ball moved in proportion to its inverse mass.
+No velocity is added, so removing an overlap never launches a ball (design.md), and the potential
+energy a separation adds against gravity is taken out of the moved balls' kinetic energy, so it never
+adds energy either. Each overlapping contact's linearised gap g = n·(x_a − x_b) − offset is driven to
+zero by a few Gauss–Seidel sweeps over the contact colours, each ball moved in proportion to its
+inverse mass.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import numpy as np
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
-from .state import State, X, with_static
+from .state import State, V, X, with_static
 
 # Overlaps shallower than this (m) are left alone: rounding, not penetration.
 OVERLAP_TOLERANCE = 1e-7
@@ -37,7 +39,30 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
             pos[a] += depth * share[idx, None]
             pos[b] -= depth * (1.0 - share[idx, None])
         pos[-1] = 0.0
-    x[:] = keep_sides_of_planes(model, state, x, pos[:-1])
+    new = keep_sides_of_planes(model, state, x, pos[:-1])
+    pay_for_lift(model, state, x, new)
+    x[:] = new
+
+
+def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray) -> None:
+    """Take the potential energy a separation adds, ΔU = −Σ m·g·Δx, out of the moved balls' kinetic
+    energy (their velocities scaled by √(1 − ΔU/K)), so removing overlaps never adds energy.
+
+    Moving positions alone lifts balls against gravity: in a closed elastic box that once made the
+    total energy creep up by 1e-5 every few seconds (nphysics #69 and haxball #2157 report the same).
+    A lowering separation is left alone: energy lost there stays lost.
+    """
+    moved = np.flatnonzero((new != old).any(axis=1))
+    if moved.size == 0:
+        return
+    mass = model.spheres.mass[moved]
+    lift = -float(mass @ ((new[moved] - old[moved]) @ model.gravity))
+    if lift <= 0.0:
+        return
+    v = state.body[moved, V]
+    kinetic = 0.5 * float(mass @ np.einsum("ij,ij->i", v, v))
+    scale = np.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
+    state.body[moved, V] = v * scale
 
 
 def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.ndarray) -> np.ndarray:

@@ -122,15 +122,15 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
             batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):
             penetration.remove_penetration(model, state, touching, batch)
-        no_allowance = np.zeros(len(touching))
+        closing = np.zeros(len(touching))  # touching contacts may not close at all: allowance and target
         with prof.stage("impacts"):
-            impacts.bounce(model, state, touching, batch, step.threshold, no_allowance, step.events, now,
+            impacts.bounce(model, state, touching, batch, step.threshold, closing, step.events, now,
                            arrivals_only=False)  # fmt: skip
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, step.forces)
         with prof.stage("resting solve"):
             push = resting.resting_forces(model, state, touching, batch, free, ang, remaining, dt,
-                                          no_allowance, step.warm, step.events, now)  # fmt: skip
+                                          closing, step.warm, step.events, now)  # fmt: skip
         lin = free if push is None else free + push.lin
         # The first interval's free path was checked against the boxes when the pairs were taken; a
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again

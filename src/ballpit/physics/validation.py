@@ -7,6 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from . import quaternion as rotations
+
 # What the engine can step: far enough inside float64 that squares, products and sums of these never
 # overflow or underflow (a speed of 1e154 m/s once overflowed v² in the time of impact and hung a step).
 MAX_COORDINATE = 1e9  # m, any coordinate of a ball or plane centre
@@ -82,7 +84,7 @@ def quaternion(name: str, value: object) -> np.ndarray:
     return q / norm
 
 
-def size(name: str, value: object) -> tuple[float, float]:
+def plane_size(name: str, value: object) -> tuple[float, float]:
     """A plane's size: a number (square side) or (width, depth), each positive; inf means unbounded."""
     if isinstance(value, Sequence) and not isinstance(value, str):
         if len(value) != 2:
@@ -152,3 +154,85 @@ def undo_non_finite_step(body: np.ndarray, before: np.ndarray) -> None:
         bad = int(np.flatnonzero(~np.isfinite(body).all(axis=1))[0])
         body[:] = before
         raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
+
+
+def _symmetric(limit: float) -> tuple[float, float]:
+    return (-limit, limit)
+
+
+def ball(position, radius, mass, velocity, angular_velocity, orientation, restitution, friction,
+         rolling_friction, hollow) -> dict:  # fmt: skip
+    """``World.add_sphere``'s arguments, checked: the ball's state and properties by column name."""
+    if not isinstance(hollow, bool | np.bool_):
+        raise TypeError(f"hollow must be True or False, got {hollow!r}")
+    return dict(
+        position=vector("position", position, limit=MAX_COORDINATE),
+        velocity=vector("velocity", velocity, limit=MAX_SPEED),
+        angular_velocity=vector("angular_velocity", angular_velocity, limit=MAX_SPIN),
+        orientation=quaternion("orientation", orientation),
+        radius=number("radius", radius, within=RADIUS_RANGE),
+        mass=number("mass", mass, within=MASS_RANGE),
+        restitution=number("restitution", restitution, nonnegative=True),
+        friction=number("friction", friction, nonnegative=True),
+        rolling_friction=number("rolling_friction", rolling_friction, nonnegative=True),
+        hollow=bool(hollow),
+    )
+
+
+def balls(positions, radius, mass, velocity, angular_velocity, orientation, restitution, friction,
+          rolling_friction, hollow) -> dict:  # fmt: skip
+    """``World.add_spheres``' arguments, checked and broadcast against ``positions`` (N, 3)."""
+    pos = np.asarray(positions, dtype=float)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise ValueError(f"positions must have shape (N, 3), got shape {pos.shape}")
+    n = len(pos)
+    rows = dict(
+        position=array_of("positions", pos, n, 3, _symmetric(MAX_COORDINATE)),
+        velocity=array_of("velocity", velocity, n, 3, _symmetric(MAX_SPEED)),
+        angular_velocity=array_of("angular_velocity", angular_velocity, n, 3, _symmetric(MAX_SPIN)),
+        orientation=array_of("orientation", orientation, n, 4),
+        radius=array_of("radius", radius, n, None, RADIUS_RANGE),
+        mass=array_of("mass", mass, n, None, MASS_RANGE),
+        restitution=array_of("restitution", restitution, n, None, (0.0, math.inf)),
+        friction=array_of("friction", friction, n, None, (0.0, math.inf)),
+        rolling_friction=array_of("rolling_friction", rolling_friction, n, None, (0.0, math.inf)),
+    )
+    q = rows["orientation"]
+    q = q / np.maximum(np.abs(q).max(axis=1, keepdims=True), 1.0)  # huge components keep their turn
+    qnorm = np.linalg.norm(q, axis=1)
+    if np.any(qnorm < 1e-12):
+        raise ValueError("orientation must not be a zero quaternion")
+    rows["orientation"] = q / qnorm[:, None]
+    hollow_in = np.asarray(hollow)
+    if hollow_in.dtype != np.bool_:
+        raise TypeError(f"hollow must be True or False (or an array of them), got {hollow!r}")
+    rows["hollow"] = np.broadcast_to(hollow_in, (n,))
+    return rows
+
+
+def plane(position, normal, rotation, size, restitution, friction, rolling_friction, velocity,
+          angular_velocity) -> tuple:  # fmt: skip
+    """``World.add_plane``'s arguments, checked: centre, orientation (turning +y to the normal),
+    (width, depth), materials and motion."""
+    center = vector("position", position, limit=MAX_COORDINATE)
+    if normal is not None and rotation is not None:
+        raise ValueError(
+            f"give a plane's normal or its rotation, not both (normal={normal!r}, rotation={rotation!r})"
+        )
+    if rotation is not None:
+        q = rotations.from_euler_xyz(vector("rotation", rotation))
+    elif normal is not None:
+        q = rotations.from_up_to(unit_vector("normal", normal))
+    else:
+        q = rotations.IDENTITY.copy()
+    extent = (math.inf, math.inf) if size is None else plane_size("size", size)
+    materials = {
+        "restitution": number("restitution", restitution, nonnegative=True),
+        "friction": number("friction", friction, nonnegative=True),
+        "rolling_friction": number("rolling_friction", rolling_friction, nonnegative=True),
+    }
+    motion = {
+        "velocity": vector("velocity", velocity, limit=MAX_SPEED),
+        "angular_velocity": vector("angular_velocity", angular_velocity, limit=MAX_SPIN),
+    }
+    return center, q, extent, materials, motion

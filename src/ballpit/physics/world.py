@@ -9,12 +9,11 @@ caches that change results: the broad phase's kept pairs (pairs.py) and the warm
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
 from time import perf_counter
 
 import numpy as np
 
-from . import energy, moving_planes, narrowphase, quaternion, strategies, validation
+from . import energy, moving_planes, narrowphase, strategies, validation
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .contacts import ContactRecord, EventLog
 from .forces import ForceTerm, free_acceleration
@@ -31,25 +30,11 @@ from .model import (
 from .pairs import PairCache
 from .profile import StepProfile
 from .resting import WarmStart
+from .snapshot import Snapshot
 from .state import Q, State, V, W, X
 
 # The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
 DEFAULT_TIMESTEP = 1.0 / 240.0
-
-
-@dataclass(frozen=True)
-class Snapshot:
-    """Everything a World's future depends on, frozen at one moment (``World.snapshot``)."""
-
-    model: Model
-    state: State
-    pairs: PairCache
-    warm: WarmStart
-    crowded_steps: int
-
-
-def _symmetric(limit: float) -> tuple[float, float]:
-    return (-limit, limit)
 
 
 def _model_number(name: str, doc: str, **checks: bool) -> property:
@@ -178,23 +163,9 @@ class World:
         hollow: bool = False,
     ) -> Sphere:
         """Add one ball and return its live view."""
-        row = dict(
-            position=validation.vector("position", position, limit=validation.MAX_COORDINATE),
-            velocity=validation.vector("velocity", velocity, limit=validation.MAX_SPEED),
-            angular_velocity=validation.vector(
-                "angular_velocity", angular_velocity, limit=validation.MAX_SPIN
-            ),
-            orientation=validation.quaternion("orientation", orientation),
-            radius=validation.number("radius", radius, within=validation.RADIUS_RANGE),
-            mass=validation.number("mass", mass, within=validation.MASS_RANGE),
-            restitution=validation.number("restitution", restitution, nonnegative=True),
-            friction=validation.number("friction", friction, nonnegative=True),
-            rolling_friction=validation.number("rolling_friction", rolling_friction, nonnegative=True),
-        )
-        if not isinstance(hollow, bool | np.bool_):
-            raise TypeError(f"hollow must be True or False, got {hollow!r}")
-        first = self._append_spheres(1, hollow=bool(hollow), **row)
-        return Sphere(self, first)
+        row = validation.ball(position, radius, mass, velocity, angular_velocity, orientation, restitution,
+                              friction, rolling_friction, hollow)  # fmt: skip
+        return Sphere(self, self._append_spheres(1, **row))
 
     def add_spheres(
         self,
@@ -213,37 +184,10 @@ class World:
 
         Returns the new balls' indices.
         """
-        pos = np.asarray(positions, dtype=float)
-        if pos.ndim != 2 or pos.shape[1] != 3:
-            raise ValueError(f"positions must have shape (N, 3), got shape {pos.shape}")
-        n = len(pos)
-        rows = dict(
-            position=validation.array_of("positions", pos, n, 3, _symmetric(validation.MAX_COORDINATE)),
-            velocity=validation.array_of("velocity", velocity, n, 3, _symmetric(validation.MAX_SPEED)),
-            angular_velocity=validation.array_of(
-                "angular_velocity", angular_velocity, n, 3, _symmetric(validation.MAX_SPIN)
-            ),
-            orientation=validation.array_of("orientation", orientation, n, 4),
-            radius=validation.array_of("radius", radius, n, None, validation.RADIUS_RANGE),
-            mass=validation.array_of("mass", mass, n, None, validation.MASS_RANGE),
-            restitution=validation.array_of("restitution", restitution, n, None),
-            friction=validation.array_of("friction", friction, n, None),
-            rolling_friction=validation.array_of("rolling_friction", rolling_friction, n, None),
-        )
-        for key in ("restitution", "friction", "rolling_friction"):
-            if np.any(rows[key] < 0):
-                raise ValueError(f"{key} must not be negative, got {rows[key][rows[key] < 0][0]!r}")
-        q = rows["orientation"]
-        q = q / np.maximum(np.abs(q).max(axis=1, keepdims=True), 1.0)  # huge components keep their turn
-        qnorm = np.linalg.norm(q, axis=1)
-        if np.any(qnorm < 1e-12):
-            raise ValueError("orientation must not be a zero quaternion")
-        rows["orientation"] = q / qnorm[:, None]
-        hollow_in = np.asarray(hollow)
-        if hollow_in.dtype != np.bool_:
-            raise TypeError(f"hollow must be True or False (or an array of them), got {hollow!r}")
-        hollow_arr = np.broadcast_to(hollow_in, (n,))
-        first = self._append_spheres(n, hollow=hollow_arr, **rows)
+        rows = validation.balls(positions, radius, mass, velocity, angular_velocity, orientation, restitution,
+                                friction, rolling_friction, hollow)  # fmt: skip
+        n = len(rows["position"])
+        first = self._append_spheres(n, **rows)
         return np.arange(first, first + n)
 
     def _append_spheres(self, n: int, *, position, velocity, angular_velocity, orientation,
@@ -276,31 +220,21 @@ class World:
         A plane is kinematic: ``velocity`` (m/s) and ``angular_velocity`` (rad/s, world frame, about
         its centre) move it during each step, and no ball pushes it.
         """
-        center = validation.vector("position", position, limit=validation.MAX_COORDINATE)
-        if normal is not None and rotation is not None:
-            raise ValueError(
-                f"give a plane's normal or its rotation, not both (normal={normal!r}, rotation={rotation!r})"
-            )
-        if rotation is not None:
-            q = quaternion.from_euler_xyz(validation.vector("rotation", rotation))
-        elif normal is not None:
-            q = quaternion.from_up_to(validation.unit_vector("normal", normal))
-        else:
-            q = quaternion.IDENTITY.copy()
-        width, depth = (np.inf, np.inf) if size is None else validation.size("size", size)
-        mat = {
-            "restitution": validation.number("restitution", restitution, nonnegative=True),
-            "friction": validation.number("friction", friction, nonnegative=True),
-            "rolling_friction": validation.number("rolling_friction", rolling_friction, nonnegative=True),
-        }
+        center, q, (width, depth), mat, motion = validation.plane(
+            position,
+            normal,
+            rotation,
+            size,
+            restitution,
+            friction,
+            rolling_friction,
+            velocity,
+            angular_velocity,
+        )
         shape = self.model.planes
         i = shape.reserve(1).start
         shape.full("half_size")[i] = (0.5 * width, 0.5 * depth)
-        shape.full("velocity")[i] = validation.vector("velocity", velocity, limit=validation.MAX_SPEED)
-        shape.full("angular_velocity")[i] = validation.vector(
-            "angular_velocity", angular_velocity, limit=validation.MAX_SPIN
-        )
-        for key, value in mat.items():
+        for key, value in {**mat, **motion}.items():
             shape.full(key)[i] = value
         pose = self.state.planes
         pose.reserve(1)

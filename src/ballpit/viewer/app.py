@@ -39,7 +39,8 @@ def title(scene_name: str, fps: float) -> str:
 
 
 class Viewer:
-    """One window on one Simulation."""
+    """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
+    file ``scene_path`` (the bundled demo by default)."""
 
     def __init__(
         self,
@@ -47,6 +48,8 @@ class Viewer:
         scene_path: Path | None = None,
         size: tuple[int, int] = (1280, 720),
         visible: bool = True,
+        trajectory: object = None,
+        record: Path | None = None,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -54,14 +57,24 @@ class Viewer:
         from .camera import Camera
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
+        from .interaction import Interaction
         from .renderer import Renderer
+        from .screen import ScreenOverlay
 
         if world is None:
-            import ballpit
+            from ballpit.scene import read_scene
 
             scene_path = Path(scene_path) if scene_path is not None else default_scene()
-            world = ballpit.load_scene(scene_path)
-        self.sim = Simulation(world, scene_path)
+            world = read_scene(scene_path)
+        self.sim = Simulation(world, scene_path, trajectory=trajectory)
+        self.interaction = Interaction(self.sim)
+        self.recorder = None
+        if record is not None:
+            from .recording import Recorder
+
+            self.recorder = Recorder(record, self.sim)
+        if trajectory is not None:
+            self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
         self.window = self._open_window(size, visible)
@@ -69,6 +82,7 @@ class Viewer:
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
+        self.screen = ScreenOverlay(self.window, self.sim)
         self.held: set[str] = set()
         self.mouse_captured = False
         self._quit_armed_until = 0.0  # a second Esc before this time quits
@@ -76,6 +90,7 @@ class Viewer:
         self._window_closed = False
         self.screenshot_requested = False
         self.last_screenshot: Path | None = None
+        self.last_save: Path | None = None
         self.physics_seconds = 0.0
         self.fps = 0.0
         self.frames = 0
@@ -144,16 +159,34 @@ class Viewer:
             self.flags.trails = not self.flags.trails
         elif action is Action.HUD:
             self.hud.show_hud = not self.hud.show_hud
+        elif action is Action.PROFILE:
+            self.hud.page = "stats" if self.hud.page == "profile" else "profile"
+            self.hud.show_hud = True
         elif action is Action.HELP:
             self.hud.show_help = not self.hud.show_help
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
+        elif action in controls.TIME_ACTIONS:
+            controls.TIME_ACTIONS[action](sim)
+        elif action is Action.ENERGY_PLOT:
+            self.screen.show_plot = not self.screen.show_plot
+        elif action is Action.SHOOT:
+            self.interaction.shoot(self.camera)
+        elif action is Action.SHOT_SPEED:
+            sim.message = f"shot speed {self.interaction.next_shot_speed():g} m/s"
+        elif action is Action.HOME:
+            self.camera.look_from(sim.appearance.camera_position, sim.appearance.camera_look_at)
+        elif action is Action.SAVE:
+            self.save_scene()
         self._hud_at = 0.0  # refresh the HUD on the next frame
 
     def escape(self) -> None:
         """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
         until then the HUD asks for it."""
         now = time.perf_counter()
+        if not self.mouse_captured and self.interaction.deselect():
+            self.hud.flash("plane deselected", now)
+            return
         outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
         if outcome == "quit":
             self.close()
@@ -168,6 +201,22 @@ class Viewer:
         self.hud.set_error(self.sim.error)
         return ok
 
+    def save_scene(self) -> Path | None:
+        """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
+        from .save import save_scene
+
+        try:
+            self.last_save = save_scene(self.sim, self.camera, self.interaction.own_motion())
+        except OSError as exc:
+            self.hud.flash(f"save failed: {exc}", time.perf_counter())
+            return None
+        shown = self.last_save
+        if shown.is_relative_to(Path.cwd()):
+            shown = shown.relative_to(Path.cwd())
+        print(f"scene saved to {self.last_save}", flush=True)
+        self.hud.flash(f"scene saved to {shown}", time.perf_counter())
+        return self.last_save
+
     def capture_mouse(self, captured: bool) -> None:
         self.mouse_captured = captured
         self.window.set_exclusive_mouse(captured)
@@ -180,17 +229,28 @@ class Viewer:
             self._close_window()
 
     def _close_window(self) -> None:
+        self.finish_record()
         if not self._window_closed:
             self._window_closed = True
             self.window.close()
+
+    def finish_record(self) -> None:
+        """Write the ``--record`` file (once), when the window closes or the run is interrupted."""
+        if self.recorder is not None and not self.recorder.finished:
+            steps, path = self.recorder.steps, self.recorder.finish()
+            print(f"recorded {steps} steps ({self.sim.ball_count} balls) to {path}", flush=True)
 
     # ------------------------------------------------------------------ pyglet events
     def on_key_press(self, symbol: int, modifiers: int) -> bool:
         from pyglet.window import key
 
         name = key.symbol_string(symbol)
-        self.held.add(name)
-        action = controls.action_for_key(name, ctrl=bool(modifiers & key.MOD_ACCEL))
+        ctrl = bool(modifiers & key.MOD_ACCEL)
+        if not (ctrl and name in controls.FLY_KEYS):  # Ctrl+S saves; it does not fly back
+            self.held.add(name)
+        if self.interaction.takes_key(name):  # arrows and PgUp/PgDn move a selected plane while held
+            return True
+        action = controls.action_for_key(name, ctrl=ctrl, shift=bool(modifiers & key.MOD_SHIFT))
         if action is not None:
             self.perform(action)
         return True  # handled: stops pyglet's default "Esc closes the window"
@@ -210,9 +270,31 @@ class Viewer:
     def on_deactivate(self) -> None:
         self.held.clear()
 
+    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        if button == mouse.LEFT and self.screen.press(x, y):  # on the timeline bar: scrub
+            return
+        from .picking import pointer_ray
+
+        if button == mouse.LEFT and not self.mouse_captured:
+            ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
+            self.sim.message = self.interaction.press(ray, x, y, self.camera.forward) or self.sim.message
+
+    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        from pyglet.window import mouse
+
+        self.screen.release()
+        if button == mouse.LEFT:
+            self.interaction.release()
+
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        if buttons & mouse.LEFT and self.screen.drag(x, y):
+            return
+        if buttons & mouse.LEFT:
+            self.interaction.move(x, y)
         if buttons & mouse.RIGHT or self.mouse_captured:
             self.camera.look(dx, dy)
 
@@ -228,6 +310,7 @@ class Viewer:
 
     def on_close(self) -> None:
         self.closed = True
+        self.finish_record()
 
     def on_draw(self) -> None:
         self.frame()
@@ -242,6 +325,8 @@ class Viewer:
             controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
         )
 
+        size = (self.window.width, self.window.height)
+        self.interaction.update(self.camera, size, self.held, elapsed)
         started = time.perf_counter()
         self.sim.advance(elapsed)
         self.physics_seconds = time.perf_counter() - started
@@ -251,10 +336,14 @@ class Viewer:
                 self.reload()
 
         self.window.switch_to()
-        self.feeder.upload(self.sim, self.flags, self.camera.position)
+        selected = self.interaction.selected_plane
+        self.renderer.selected_plane = -1 if selected is None else selected
+        self.feeder.upload(self.sim, self.flags, self.camera.position, self.interaction.lines())
+        self.screen.upload(self.renderer)
         width, height = self.window.get_framebuffer_size()
         self.renderer.draw(self.camera, width, height, multisample=self.multisample)
         self._draw_hud(now)
+        self.screen.draw_labels()
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -266,11 +355,18 @@ class Viewer:
                                               ("trails", f.trails)) if on)  # fmt: skip
 
     def _draw_hud(self, now: float) -> None:
-        from .hud import hud_lines
+        from .hud import hud_lines, profile_lines
 
+        if self.hud.bottom != self.screen.bottom_clearance():
+            self.hud.bottom = self.screen.bottom_clearance()
+            self.hud.layout()
         if now >= self._hud_at:
             self._hud_at = now + HUD_INTERVAL
-            self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names()))
+            if self.hud.page == "profile":
+                self.hud.set_text(profile_lines(self.sim))
+            else:
+                extra, shot = self.interaction.hud_lines(), self.interaction.shot_speed
+                self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names(), extra, shot))
             self.hud.set_error(self.sim.error)
         if self.sim.message != self._shown_message:
             self._shown_message = self.sim.message
@@ -334,21 +430,26 @@ class Viewer:
         self._pyglet.app.run(FRAME_INTERVAL)
 
 
-def run(scene_path: Path | None = None) -> int:
+def run(scene_path: Path | None = None, trajectory: object = None, record: Path | None = None) -> int:
     """Open the viewer on a scene file (the bundled slopes demo by default); returns the exit status.
+    With ``record``, the timeline it showed is written there when the window closes (or on Ctrl+C).
 
-    With no display it prints one line saying how to render offscreen instead and returns 1.
+    With no display it prints one line saying how to render offscreen instead and returns 1. With a
+    ``trajectory`` (``replay.read_trajectory``) the window plays it instead of running the physics.
     """
     problem = backend.display_problem()
     if problem is not None:
         print(backend.no_display_message(problem), file=sys.stderr)
         return 1
     try:
-        viewer = Viewer(scene_path=scene_path)
+        viewer = Viewer(scene_path=scene_path, trajectory=trajectory, record=record)
     except Exception as exc:
         if _is_no_display(exc):
             print(backend.no_display_message(str(exc) or "cannot connect"), file=sys.stderr)
             return 1
         raise
-    viewer.run()
+    try:
+        viewer.run()
+    finally:
+        viewer.finish_record()
     return 0

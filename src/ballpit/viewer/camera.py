@@ -45,6 +45,11 @@ class Camera:
         pitch = float(np.clip(math.asin(np.clip(d[1] / length, -1.0, 1.0)), -PITCH_LIMIT, PITCH_LIMIT))
         return cls(position=position, yaw=yaw, pitch=pitch, **kwargs)
 
+    def look_from(self, position: object, target: object) -> None:
+        """Move to ``position`` and look at ``target`` (Home: back to the scene's view); speed is kept."""
+        other = Camera.looking_at(position, target)
+        self.position, self.yaw, self.pitch = other.position, other.yaw, other.pitch
+
     # ------------------------------------------------------------------ directions
     @property
     def forward(self) -> np.ndarray:

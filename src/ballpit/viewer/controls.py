@@ -10,8 +10,9 @@ and is built from the same bindings.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
@@ -35,8 +36,18 @@ class Action(Enum):
     VELOCITIES = "show velocity arrows"
     TRAILS = "show trails"
     HUD = "show / hide the HUD"
+    PROFILE = "HUD page: where the step's time goes"
     HELP = "show / hide this help"
     SCREENSHOT = "save a screenshot PNG"
+    STEP_BACK = "one step back through the history while paused"
+    JUMP_BACK = "a second back through the history while paused"
+    JUMP_FORWARD = "a second forward through the history while paused"
+    GHOSTS = "integrator ghosts and their energy drift"
+    ENERGY_PLOT = "live energy plot"
+    SHOOT = "shoot a ball along the view"
+    SHOT_SPEED = "change the shot speed"
+    HOME = "camera back to the scene's view"
+    SAVE = "save the scene as it stands to a new file"
 
 
 KEY_ACTIONS: dict[str, Action] = {
@@ -59,10 +70,21 @@ KEY_ACTIONS: dict[str, Action] = {
     "T": Action.TRAILS,
     "H": Action.HUD,
     "F1": Action.HELP,
+    "F2": Action.PROFILE,
     "F12": Action.SCREENSHOT,
+    "LEFT": Action.STEP_BACK,
+    "G": Action.GHOSTS,
+    "P": Action.ENERGY_PLOT,
+    "B": Action.SHOOT,
+    "HOME": Action.HOME,
 }
 
-CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD}
+CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD, "S": Action.SAVE}
+SHIFT_KEY_ACTIONS: dict[str, Action] = {
+    "LEFT": Action.JUMP_BACK,
+    "RIGHT": Action.JUMP_FORWARD,
+    "B": Action.SHOT_SPEED,
+}
 
 # Typed text → action. "=" is the + key without Shift, "_" the − key with it.
 TEXT_ACTIONS: dict[str, Action] = {
@@ -99,27 +121,31 @@ QUIT_HINT = "press Esc again to quit"
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
 
 HELP: tuple[tuple[str, str], ...] = (
-    ("X", "start the drop (the scene waits until X)"),
-    ("Space", "pause / resume"),
+    ("X / Space", "start the drop (it waits for X) / pause"),
     ("N or →", "single step while paused"),
-    ("R", "reset to the initial state (then X drops again)"),
-    ("Ctrl+R or F5", "reload the scene file (also on save)"),
-    ("1 / 2 / 3", "integrator Euler / RK2 / RK4"),
-    ("+ / −", "faster / slower time"),
+    ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
+    ("R / Ctrl+R or F5", "reset (X drops again) / reload (also on save)"),
+    ("1 / 2 / 3, + / −", "Euler / RK2 / RK4; faster / slower time"),
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
-    ("Esc", "release the mouse; Esc twice quits"),
-    ("C / V / T", "contacts and normals / velocity arrows / trails"),
-    ("H / F1", "HUD / this help"),
-    ("F12", "screenshot PNG into screenshots/"),
+    ("Esc", "release the mouse, drop a plane; twice quits"),
+    ("C / V / T, G / P", "contacts, velocities, trails; ghosts, energy plot"),
+    ("H / F1 / F2", "HUD / this help / HUD page: time per stage"),
+    ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
+    ("left-drag a ball", "pick it up and move it; let go to throw it"),
+    ("B / Shift+B", "shoot a ball along the view / its speed"),
+    ("click a plane", "select it: arrows tilt it, PgUp/PgDn lift it"),
+    ("Home", "camera back to the scene's view"),
 )
 
 
-def action_for_key(name: str, ctrl: bool = False) -> Action | None:
+def action_for_key(name: str, ctrl: bool = False, shift: bool = False) -> Action | None:
     """The action bound to a key press, or None. ``name`` is pyglet's key symbol name."""
     if ctrl:
         return CTRL_KEY_ACTIONS.get(name)
+    if shift and name in SHIFT_KEY_ACTIONS:
+        return SHIFT_KEY_ACTIONS[name]
     return KEY_ACTIONS.get(name)
 
 
@@ -166,3 +192,12 @@ def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
     if mouse_captured:
         return "release"
     return "quit" if armed else "arm"
+
+
+# Moving in time and the ghosts: what each asks of the Simulation.
+TIME_ACTIONS: dict[Action, Callable[[Any], None]] = {
+    Action.STEP_BACK: lambda sim: sim.step_back(),
+    Action.JUMP_BACK: lambda sim: sim.jump(-1.0),
+    Action.JUMP_FORWARD: lambda sim: sim.jump(1.0),
+    Action.GHOSTS: lambda sim: sim.toggle_ghosts(),
+}

@@ -8,6 +8,8 @@ small for both shows the help alone).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pyglet
 
 from .controls import HELP
@@ -22,8 +24,15 @@ MARGIN = 10
 MESSAGE_SECONDS = 3.0
 
 
-def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
-    """The HUD's text: time, speed, integrator, step rate, counts, energy and the run state."""
+def hud_lines(
+    sim: Simulation,
+    fly_speed: float,
+    overlays: str,
+    extra: Sequence[str] = (),
+    shot_speed: float | None = None,
+) -> list[str]:
+    """The HUD's text: time, speed, integrator, step rate, counts, energy, fly (and shot) speed,
+    ``extra`` lines and the run state."""
     world = sim.world
     state = sim.phase.value
     if sim.phase is Phase.RUNNING and sim.time_scale != 1.0:
@@ -37,11 +46,45 @@ def hud_lines(sim: Simulation, fly_speed: float, overlays: str) -> list[str]:
         f"balls       {sim.ball_count:9d}",
         f"contacts    {sim.last_step_contacts:9d}",
         f"kinetic E   {sim.kinetic_energy():9.3f} J",
-        f"fly speed   {fly_speed:9.2f} m/s",
+        f"fly speed   {fly_speed:9.2f} m/s" + ("" if shot_speed is None else f"  shot {shot_speed:g} m/s"),
         f"overlays    {overlays or 'none'} (C V T)",
+        *extra,
         f"state       {state}",
-        "F1 help  H hide",
+        *timeline_lines(sim),
+        "F1 help  F2 profile  H hide",
     ]
+
+
+def profile_lines(sim: Simulation) -> list[str]:
+    """The HUD's profile page: where the step's time went over the last second, stage by stage
+    (``World.profile``, like Box2D's b2Profile), with intervals, pairs and contacts per step."""
+    p = sim.profile
+    if not p.steps:
+        return [f"{sim.appearance.name}: step profile", "no steps yet (X drops)", "F2 back  H hide"]
+    return [
+        f"{sim.appearance.name}: step profile, {p.steps} steps",
+        f"{'stage':<15}{'per step':>12}",
+        *p.lines(),
+        "F2 back  H hide",
+    ]
+
+
+def timeline_lines(sim: Simulation) -> list[str]:
+    """HUD lines for the history or replay and, with ghosts on, each integrator's energy drift."""
+    from .ghosts import LABELS
+
+    timeline = sim.timeline
+    lines = []
+    span = timeline.span()
+    if timeline.replay is not None:
+        lines.append(f"replay      {timeline.replay.trajectory.path.name}")
+    elif span is not None and timeline.history is not None and timeline.history.in_past:
+        lines.append(f"history     {span[2] - span[1]:.3f} s in the past (Space resumes from here)")
+    for name, drift, main in timeline.drifts():
+        what = "run  " if main else "ghost"
+        unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"
+        lines.append(f"E drift {what} {LABELS[name]:5s} {drift:+10.4f} {unit}")
+    return lines
 
 
 def help_text() -> str:
@@ -58,12 +101,14 @@ class Hud:
         self.batch = pyglet.graphics.Batch()
         self.help_batch = pyglet.graphics.Batch()
         self.show_hud = True
+        self.page = "stats"  # or "profile" (F2)
         self.show_help = False
         self.text = ""
         self.error = ""
         self.message = ""
         self._message_until = 0.0
         self.help_hides_hud = False  # the window has no room for both: the help is drawn alone
+        self.bottom = 0  # pixels kept clear at the bottom (the timeline bar): messages go above them
         self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
         self.label = pyglet.text.Label(
@@ -89,9 +134,11 @@ class Hud:
         w, h = self.window.width, self.window.height
         self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
         self.error_label.width = max(w - 2 * MARGIN, 100)
-        self.error_label.x, self.error_label.y = MARGIN, MARGIN
+        self.error_label.x, self.error_label.y = MARGIN, MARGIN + self.bottom
         self.message_label.x = MARGIN
-        self.message_label.y = MARGIN + (self.error_label.content_height + 6 if self.error else 0)
+        self.message_label.y = (
+            MARGIN + self.bottom + (self.error_label.content_height + 6 if self.error else 0)
+        )
         self._fit_panel()
 
     def _fit_panel(self) -> None:

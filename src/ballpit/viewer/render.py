@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from . import backend
-from .appearance import appearance_of
 from .camera import Camera
 from .simulation import Simulation
 
@@ -136,10 +135,10 @@ def render(
     progress: bool = True,
 ) -> Path:
     """Render the scene file's drop, starting at once, to ``out``; returns the path written."""
-    import ballpit
+    from ballpit.scene import read_scene
 
-    world = ballpit.load_scene(scene_path)
-    return render_world(world, out, duration, fps, size, progress, scene_path=Path(scene_path))
+    scene = read_scene(scene_path)
+    return render_world(scene, out, duration, fps, size, progress, scene_path=Path(scene_path))
 
 
 def render_world(
@@ -152,7 +151,7 @@ def render_world(
     scene_path: Path | None = None,
     samples: int = 4,
 ) -> Path:
-    """Render a World (built in code or loaded) like ``render`` does."""
+    """Render a Scene, or a World built in code, like ``render`` does."""
     from PIL import Image
     from tqdm import tqdm
 
@@ -167,7 +166,7 @@ def render_world(
         out.parent.mkdir(parents=True, exist_ok=True)
 
     sim = Simulation(world, scene_path, step_budget=math.inf)
-    look = appearance_of(world, scene_path)
+    look = sim.appearance
     camera = Camera.looking_at(look.camera_position, look.camera_look_at)
     sim.start()
     images: list[Image.Image] = []

@@ -118,6 +118,19 @@ class Renderer:
         self._sorted = np.zeros((0, BALL_STRIDE), dtype=np.float32)
         self.ball_count = 0
 
+        # ghost balls (G): the same quad, their own instance buffer, drawn translucent after the balls
+        self.ghost_vao = GL.glGenVertexArrays(1)
+        self.ghost_vbo = GL.glGenBuffers(1)
+        GL.glBindVertexArray(self.ghost_vao)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.corner_vbo)
+        _attribute(0, 2, 2, 0)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.ghost_vbo)
+        _attribute(1, 4, BALL_STRIDE, 0, divisor=1)
+        _attribute(2, 4, BALL_STRIDE, 4, divisor=1)
+        _attribute(3, 4, BALL_STRIDE, 8, divisor=1)
+        self.ghost_count = 0
+        self.ghost_alpha = 0.4
+
         # planes: two triangles each, rebuilt when the scene changes or a plane moves
         self.plane_vao = GL.glGenVertexArrays(1)
         self.plane_vbo = GL.glGenBuffers(1)
@@ -126,6 +139,7 @@ class Renderer:
         for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10)]):
             _attribute(index, size, PLANE_STRIDE, offset)
         self.plane_vertices = 0
+        self.selected_plane = -1  # drawn with a highlighted rim (or tint, if infinite); -1: none
         self._plane_centers = np.zeros((0, 3))
         self._plane_normals = np.zeros((0, 3))
 
@@ -160,6 +174,17 @@ class Renderer:
         _attribute(1, 4, VERTEX_WIDTH, 3)
         self.world_line_vertices = 0
         self.overlay_line_vertices = 0
+
+        # screen-space overlays in window pixels (timeline bar, energy plot): triangles, then lines
+        self.screen_vao = GL.glGenVertexArrays(1)
+        self.screen_vbo = GL.glGenBuffers(1)
+        GL.glBindVertexArray(self.screen_vao)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.screen_vbo)
+        _attribute(0, 3, VERTEX_WIDTH, 0)
+        _attribute(1, 4, VERTEX_WIDTH, 3)
+        self.screen_triangle_vertices = 0
+        self.screen_line_vertices = 0
+        self.screen_size = (1.0, 1.0)
 
         GL.glBindVertexArray(0)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
@@ -246,6 +271,34 @@ class Renderer:
         self.shadow_grid = grid
         self.shadow_seconds = time.perf_counter() - started
 
+    def upload_ghosts(
+        self, positions: np.ndarray, orientations: np.ndarray, radii: np.ndarray, colors: np.ndarray,
+        alpha: float = 0.4,
+    ) -> None:  # fmt: skip
+        """The ghost balls of every ghost world at once (one instanced draw), drawn with ``alpha``."""
+        n = len(positions)
+        inst = np.zeros((n, BALL_STRIDE), dtype=np.float32)
+        inst[:, 0:3] = positions
+        inst[:, 3] = radii
+        inst[:, 4:8] = orientations
+        inst[:, 8:11] = colors
+        inst[:, 11] = 1.0
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.ghost_vbo)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, inst.nbytes, inst if n else None, GL.GL_STREAM_DRAW)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+        self.ghost_count = n
+        self.ghost_alpha = float(alpha)
+
+    def upload_screen(self, triangles: np.ndarray, lines: np.ndarray, size: tuple[float, float]) -> None:
+        """Screen-space vertices (M, 7) in pixels of a window ``size`` (y up): panels, then lines."""
+        data = np.concatenate([triangles, lines]).astype(np.float32, copy=False)
+        self.screen_triangle_vertices, self.screen_line_vertices = len(triangles), len(lines)
+        self.screen_size = (max(float(size[0]), 1.0), max(float(size[1]), 1.0))
+        if len(data):
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.screen_vbo)
+            GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
+
     def upload_lines(self, world_lines: np.ndarray, overlay_lines: np.ndarray) -> None:
         """Line vertices (M, 7) for this frame: depth-tested world lines, then always-visible overlays."""
         data = np.concatenate([world_lines, overlay_lines]).astype(np.float32, copy=False)
@@ -264,6 +317,8 @@ class Renderer:
         program.set("u_background", self.background)
         program.set("u_fog_density", self.fog_density)
         program.set("u_sun_direction", self.sun_direction)
+        if program is self.plane_program:
+            program.set("u_selected", int(self.selected_plane))
 
     def _shadow_uniforms(self, program: Program) -> None:
         """The sun's grid for the plane shader, with its buffers bound to their texture units."""
@@ -312,12 +367,25 @@ class Renderer:
         if self.ball_count:
             self._common_uniforms(self.ball_program, view_projection, eye)
             self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
+            self.ball_program.set("u_alpha", 1.0)
             if multisample:
                 GL.glEnable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
             GL.glBindVertexArray(self.ball_vao)
             self.draws.arrays_instanced("balls", GL.GL_TRIANGLE_STRIP, 0, 4, self.ball_count)
             if multisample:
                 GL.glDisable(GL.GL_SAMPLE_ALPHA_TO_COVERAGE)
+
+        if self.ghost_count:  # translucent ghosts: blended, not writing depth
+            self._common_uniforms(self.ball_program, view_projection, eye)
+            self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
+            self.ball_program.set("u_alpha", self.ghost_alpha)
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
+            GL.glDepthMask(GL.GL_FALSE)
+            GL.glBindVertexArray(self.ghost_vao)
+            self.draws.arrays_instanced("ghosts", GL.GL_TRIANGLE_STRIP, 0, 4, self.ghost_count)
+            GL.glDepthMask(GL.GL_TRUE)
+            GL.glDisable(GL.GL_BLEND)
 
         if self.plane_vertices and self.seen_from_behind(camera.position).any():  # back faces, see-through
             self._common_uniforms(self.plane_program, view_projection, eye)
@@ -348,6 +416,24 @@ class Renderer:
                 )
             GL.glDepthMask(GL.GL_TRUE)
 
+        if self.screen_triangle_vertices or self.screen_line_vertices:
+            w, h = self.screen_size
+            # row-vector layout, like the camera's: [x, y, z, 1] @ M maps pixels to clip space
+            pixels_to_clip = np.array([[2 / w, 0, 0, 0], [0, 2 / h, 0, 0], [0, 0, 1, 0], [-1, -1, 0, 1]],
+                                      dtype=np.float32)  # fmt: skip
+            self.line_program.use()
+            self.line_program.set("u_view_projection", pixels_to_clip)
+            GL.glDisable(GL.GL_DEPTH_TEST)
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
+            GL.glBindVertexArray(self.screen_vao)
+            if self.screen_triangle_vertices:
+                self.draws.arrays("screen panels", GL.GL_TRIANGLES, 0, self.screen_triangle_vertices)
+            if self.screen_line_vertices:
+                self.draws.arrays(
+                    "screen lines", GL.GL_LINES, self.screen_triangle_vertices, self.screen_line_vertices
+                )
+
         # leave the state pyglet's own drawing (the HUD) expects
         GL.glBindVertexArray(0)
         GL.glUseProgram(0)
@@ -359,7 +445,19 @@ class Renderer:
         """Free the GL objects (the context must be current)."""
         for program in (self.ball_program, self.plane_program, self.line_program):
             program.delete()
-        GL.glDeleteBuffers(4, [self.corner_vbo, self.instance_vbo, self.plane_vbo, self.line_vbo])
+        GL.glDeleteBuffers(
+            6,
+            [
+                self.corner_vbo,
+                self.instance_vbo,
+                self.plane_vbo,
+                self.line_vbo,
+                self.ghost_vbo,
+                self.screen_vbo,
+            ],
+        )
+        GL.glDeleteVertexArrays(
+            5, [self.ball_vao, self.plane_vao, self.line_vao, self.ghost_vao, self.screen_vao]
+        )
         GL.glDeleteBuffers(2, list(self.shadow_buffers))
         GL.glDeleteTextures(2, list(self.shadow_textures))
-        GL.glDeleteVertexArrays(3, [self.ball_vao, self.plane_vao, self.line_vao])

@@ -21,7 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .appearance import Appearance, appearance_of
+from ..physics.profile import RunProfile
+from ..scene import Appearance, Scene, read_scene, scene_of
+from .replay import Trajectory
+from .timeline import Timeline
 
 MAX_FRAME_SECONDS = 0.25
 TRAIL_POINT_BUDGET = 200_000  # trail samples kept over all balls
@@ -34,12 +37,6 @@ class Phase(Enum):
     WAITING = "waiting: press X to drop"
     RUNNING = "running"
     PAUSED = "paused: Space resumes, N steps"
-
-
-def _default_loader(path: Path) -> object:
-    import ballpit
-
-    return ballpit.load_scene(path)
 
 
 def _file_signature(path: Path | None) -> tuple[int, int] | None:
@@ -72,6 +69,11 @@ class Trails:
         self.filled = min(self.filled + 1, self.length)
         self.last_time = sim_time
 
+    def grow(self, position: np.ndarray) -> None:
+        """Make room for one more ball, whose trail starts where it is now."""
+        extra = np.broadcast_to(np.asarray(position, dtype=np.float32), (self.length, 1, 3))
+        self._samples = np.concatenate([self._samples, extra], axis=1)
+
     def ordered(self) -> np.ndarray:
         """(filled, N, 3) samples, oldest first."""
         order = (self._head - self.filled + np.arange(self.filled)) % self.length
@@ -79,17 +81,23 @@ class Trails:
 
 
 class Simulation:
-    """A World being watched: the run phase, the fixed-step clock and what the viewer draws from it."""
+    """A World being watched: the run phase, the fixed-step clock and what the viewer draws from it.
+
+    Give it a Scene (from ``read_scene``), or a World built in code and optionally the file to reload;
+    ``loader`` reads that file again (``read_scene`` by default).
+    """
 
     def __init__(
         self,
-        world: object,
+        world: Scene | object,
         path: Path | None = None,
-        loader: Callable[[Path], object] | None = None,
+        loader: Callable[[Path], Scene] | None = None,
         step_budget: float = 0.05,
         clock: Callable[[], float] = time.perf_counter,
+        trajectory: Trajectory | None = None,
     ) -> None:
-        self.loader = loader or _default_loader
+        self.trajectory = trajectory  # a replayed run (``view --replay``) instead of live physics
+        self.loader = loader or read_scene
         self.step_budget = step_budget
         self.clock = clock
         self.time_scale = 1.0
@@ -97,28 +105,36 @@ class Simulation:
         self.message: str = ""
         self.generation = 0  # bumps whenever the world is replaced, so the renderer rebuilds geometry
         self.dropped_seconds = 0.0  # simulated time skipped because physics could not keep up
-        self._install(world, path)
+        # Hooks (no arguments): before and after every physics step, and whenever the run restarts
+        # (a new world, a reset or a reload). Reaching in and recording attach here.
+        self.before_step: list[Callable[[], None]] = []
+        self.after_step: list[Callable[[], None]] = []
+        self.after_reset: list[Callable[[], None]] = []
+        self.after_resume_from_past: list[Callable[[int], None]] = []  # gets the step resumed from
+        self._install(scene_of(world, path))
 
     # ------------------------------------------------------------------ world management
-    def _install(self, world: object, path: Path | None) -> None:
+    def _install(self, scene: Scene) -> None:
+        world = scene.world
+        self.scene = scene
         self.world = world
-        self.appearance: Appearance = appearance_of(world, path)
-        self.path = self.appearance.path
+        self.appearance: Appearance = scene.appearance
+        self.path = scene.path
         self.initial = copy.deepcopy(world)
         self._signature = _file_signature(self.path)
-        spheres = world.spheres
-        self.masses = np.array(spheres.masses, dtype=float)
-        self.inertias = np.array([s.inertia for s in spheres], dtype=float)  # once per world, not per frame
         self._reset_dynamics()
         self.generation += 1
 
     def _reset_dynamics(self) -> None:
         spheres = self.world.spheres
+        self.appearance.sphere_colors = self.appearance.sphere_colors[: len(spheres)]  # drop added balls
         self.phase = Phase.WAITING
         self.accumulator = 0.0
         self.alpha = 1.0
         self.prev_positions = np.array(spheres.positions, dtype=float)
         self.prev_orientations = np.array(spheres.orientations, dtype=float)
+        self.prev_plane_centers = np.array(self.world.planes.centers, dtype=float)
+        self.prev_plane_orientations = np.array(self.world.planes.orientations, dtype=float)
         self.contacts = None  # Contacts of the last frame that stepped
         self.last_step_contacts = 0
         self.trails = Trails(len(spheres))
@@ -129,10 +145,31 @@ class Simulation:
         self._stats_wall = 0.0
         self._stats_steps = 0
         self._stats_sim = 0.0
+        self.profile = RunProfile()  # the steps of the last stats window, stage by stage
+        self._profile = RunProfile()
+        self._new_timeline()
+        for hook in self.after_reset:
+            hook()
+
+    def _new_timeline(self) -> None:
+        """History, replay, ghosts and energy trace start afresh (ghosts stay on if they were)."""
+        ghosts = getattr(self, "timeline", None) is not None and self.timeline.ghosts is not None
+        trajectory = self.trajectory
+        if trajectory is not None and trajectory.balls != self.ball_count:
+            self.error = (
+                f"{trajectory.path}: the trajectory has {trajectory.balls} balls, the scene {self.ball_count}"
+            )
+            trajectory = None
+        self.timeline = Timeline(self, trajectory)
+        if trajectory is not None:
+            self.after_seek(None)  # frame 0 of the replay is in the world now
+        if ghosts:
+            self.timeline.toggle_ghosts()
+        self.timeline.sample_energy()
 
     @property
     def timestep(self) -> float:
-        return self.appearance.timestep
+        return self.scene.timestep
 
     @property
     def ball_count(self) -> int:
@@ -145,6 +182,7 @@ class Simulation:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self.message = "dropped"
+            self.timeline.started()
 
     def toggle_pause(self) -> None:
         """Space: pause a running simulation or resume a paused one."""
@@ -156,6 +194,10 @@ class Simulation:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self.message = "resumed"
+            if self.timeline.resumed():
+                self.message = "resumed from the past: the later history is dropped"
+                for hook in self.after_resume_from_past:
+                    hook(self.timeline.history.current)
         else:
             self.message = "press X to start the drop"
 
@@ -163,6 +205,8 @@ class Simulation:
         """N / →: one fixed step, only while paused."""
         if self.phase is not Phase.PAUSED:
             self.message = "N steps only while paused (Space pauses)"
+            return
+        if self.timeline.forward() or self.timeline.replay is not None:
             return
         contacts = []
         self._step(contacts)
@@ -180,6 +224,10 @@ class Simulation:
     def set_integrator(self, name: str) -> None:
         self.world.integrator = name
         self.message = f"integrator {name.upper()}"
+        ghosts = self.timeline.ghosts
+        if ghosts is not None and name in ghosts.integrators:  # the ghosts become the other two again
+            self.timeline.toggle_ghosts()
+            self.message += "; " + self.timeline.toggle_ghosts()
 
     def faster(self) -> None:
         from .controls import faster
@@ -201,12 +249,12 @@ class Simulation:
             return False
         self._signature = _file_signature(self.path)
         try:
-            world = self.loader(self.path)
+            scene = self.loader(self.path)
         except Exception as exc:  # any failure: the viewer must stay up with the old world
             self.error = f"reload of {self.path.name} failed: {_describe(exc)}"
             print(f"ballpit: {self.error} (keeping the last good scene)", file=sys.stderr, flush=True)
             return False
-        self._install(world, self.path)
+        self._install(scene)
         self.error = None
         self.message = f"reloaded {self.path.name}: press X to drop"
         return True
@@ -246,26 +294,90 @@ class Simulation:
                 steps += 1
             self._finish_steps(contacts)
             self.alpha = min(self.accumulator / dt, 1.0) if self.phase is Phase.RUNNING else 1.0
+        if steps:
+            self.timeline.sample_energy()
         self._update_stats(frame_seconds, steps)
         return steps
 
     def _step(self, contacts: list) -> None:
-        spheres = self.world.spheres
+        for hook in self.before_step:
+            hook()
+        spheres, planes = self.world.spheres, self.world.planes
         self.prev_positions[:] = spheres.positions
         self.prev_orientations[:] = spheres.orientations
+        self.prev_plane_centers[:] = planes.centers
+        self.prev_plane_orientations[:] = planes.orientations
         try:
-            result = self.world.step(self.timestep)
+            result = self.timeline.step(self.timestep)
         except Exception as exc:  # a physics failure pauses the viewer instead of killing it
             self.phase = Phase.PAUSED
             self.error = f"physics step failed: {_describe(exc)}"
             print(f"ballpit: {self.error}", file=sys.stderr, flush=True)
             return
         contacts.append(result)
+        self._profile.add(self.world.profile)
         self.last_step_contacts = len(result)
         self.steps_total += 1
         self._stats_steps += 1
         self._stats_sim += self.timestep
         self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+        for hook in self.after_step:
+            hook()
+
+    def add_ball(self, color: object, **kwargs: object) -> int:
+        """Add a ball to the live world (``World.add_sphere`` arguments) drawn in ``color``; returns its
+        index. Everything kept per ball (colours, trails, interpolation) grows with it."""
+        ball = self.world.add_sphere(**kwargs)
+        look = self.appearance
+        look.sphere_colors = np.vstack([look.sphere_colors, np.asarray(color, dtype=float).reshape(1, 3)])
+        self.prev_positions = np.vstack([self.prev_positions, ball.position])
+        self.prev_orientations = np.vstack([self.prev_orientations, ball.orientation])
+        self.trails.grow(np.asarray(ball.position, dtype=np.float32))
+        return ball.index
+
+    # ------------------------------------------------------------------ history, replay, ghosts
+    def step_back(self) -> None:
+        """←: one step back through the history, only while paused."""
+        self._move(lambda t: t.back(), "← steps back only while paused (Space pauses)")
+
+    def jump(self, seconds: float) -> None:
+        """Shift+← / Shift+→: a second back or forward through the history, only while paused."""
+        self._move(lambda t: t.jump(seconds), "Shift+←/→ jump only while paused (Space pauses)")
+
+    def scrub(self, fraction: float) -> None:
+        """Dragging on the timeline bar: pause and go to that point of the span kept (0 oldest, 1 newest)."""
+        if self.phase is Phase.RUNNING:
+            self.toggle_pause()
+        self._move(lambda t: t.scrub(fraction), "")
+
+    def _move(self, how: Callable[[Timeline], bool], refusal: str) -> None:
+        if self.phase is not Phase.PAUSED:
+            self.message = refusal if self.phase is Phase.RUNNING else "press X to start the drop"
+            return
+        if not how(self.timeline):
+            self.message = "no history yet"
+
+    def after_seek(self, contacts: object) -> None:
+        """The timeline moved the world: draw it as it is now, with no interpolation or old trails."""
+        spheres = self.world.spheres
+        self.prev_positions = np.array(spheres.positions, dtype=float)
+        self.prev_orientations = np.array(spheres.orientations, dtype=float)
+        self.alpha = 1.0
+        self.contacts = contacts
+        self.last_step_contacts = len(contacts) if contacts is not None else 0
+        self.trails = Trails(len(spheres))
+        self.trails.record(np.asarray(spheres.positions, dtype=np.float32), self.world.time)
+        self.timeline.sample_energy()
+
+    def end_of_replay(self) -> None:
+        """The replay showed its last frame: pause there."""
+        self.phase = Phase.PAUSED
+        self.message = "end of the replay: ← / drag the timeline to go back, R restarts"
+
+    def toggle_ghosts(self) -> None:
+        """G: integrator ghosts on or off."""
+        self.message = self.timeline.toggle_ghosts()
+        self.timeline.sample_energy()
 
     def _finish_steps(self, contacts: list) -> None:
         if contacts:
@@ -281,6 +393,8 @@ class Simulation:
             self._stats_wall = 0.0
             self._stats_steps = 0
             self._stats_sim = 0.0
+            if self._profile.steps:  # paused: keep showing the last window that stepped
+                self.profile, self._profile = self._profile, RunProfile()
 
     # ------------------------------------------------------------------ what to draw
     def render_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -299,11 +413,20 @@ class Simulation:
         q /= np.linalg.norm(q, axis=1, keepdims=True)
         return positions, q
 
+    def render_planes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Plane centres (P, 3) and orientations (P, 4) at the same ``alpha`` as ``render_state``."""
+        planes = self.world.planes
+        pos = np.asarray(planes.centers, dtype=float)
+        quat = np.asarray(planes.orientations, dtype=float)
+        a = self.alpha
+        if a >= 1.0 or self.phase is not Phase.RUNNING:
+            return pos, quat
+        prev_q = self.prev_plane_orientations
+        sign = np.where(np.einsum("ij,ij->i", prev_q, quat) < 0.0, -1.0, 1.0)[:, None]
+        q = prev_q * (1.0 - a) + quat * sign * a
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        return self.prev_plane_centers + (pos - self.prev_plane_centers) * a, q
+
     def kinetic_energy(self) -> float:
-        """Translational plus rotational kinetic energy of all balls, J."""
-        spheres = self.world.spheres
-        v = np.asarray(spheres.velocities)
-        w = np.asarray(spheres.angular_velocities)
-        return 0.5 * float(
-            self.masses @ np.einsum("ij,ij->i", v, v) + self.inertias @ np.einsum("ij,ij->i", w, w)
-        )
+        """Translational plus rotational kinetic energy of all balls, J (the physics' own measure)."""
+        return self.world.kinetic_energy()

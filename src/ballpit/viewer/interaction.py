@@ -1,0 +1,231 @@
+"""Reaching into the running world: pick up and throw balls, shoot balls, select and move planes.
+
+No GL and no pyglet here: the window passes in pointer rays, held key names and frame times, so this is
+testable on its own, and the Simulation's step hooks keep a held ball where the pointer is.
+
+- A held ball follows the pointer in the plane facing the camera through its centre. While time runs
+  it is kinematic: before and after every physics step its position is set to the pointer's point and
+  its velocity to the drag's (it pushes other balls, but does not fall). Letting go throws it with the
+  drag's velocity, measured over the last ``THROW_WINDOW`` seconds of frames.
+- A selected plane turns at ``TILT_RATE`` about a horizontal axis while an arrow key is held (← / →
+  about the view's horizontal forward axis, ↑ / ↓ about its right axis) and moves at ``LIFT_SPEED`` up or
+  down while PgUp / PgDn is held; letting go gives it back the motion it had when selected.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterable
+
+import numpy as np
+
+from ballpit.scene.colours import palette_colors
+
+from . import overlays
+from .camera import WORLD_UP, Camera
+from .picking import Ray, camera_basis, pick, pointer_ray, ray_plane_point
+from .simulation import Phase, Simulation
+
+THROW_WINDOW = 0.1  # s of pointer motion the throw velocity is measured over
+TILT_RATE = 0.4  # rad/s while an arrow key is held (about 23°/s)
+LIFT_SPEED = 1.0  # m/s while PgUp / PgDn is held
+SHOT_SPEEDS = (5.0, 10.0, 20.0, 40.0)  # m/s; Shift+B steps through them
+DEFAULT_SHOT_SPEED = 10.0
+SHOT_RADIUS, SHOT_MASS = 0.25, 1.0  # a shot ball when the scene has no balls to copy
+THROW_COLOR = (1.0, 0.72, 0.05, 1.0)
+# Held keys that move a selected plane: tilt keys as (camera axis, sign), lift keys as a sign.
+TILT_KEYS: dict[str, tuple[str, float]] = {
+    "UP": ("right", -1.0),  # the far edge goes down
+    "DOWN": ("right", 1.0),
+    "LEFT": ("forward", -1.0),  # the left edge goes down
+    "RIGHT": ("forward", 1.0),
+}
+LIFT_KEYS: dict[str, float] = {"PAGEUP": 1.0, "PAGEDOWN": -1.0}
+PLANE_KEYS = frozenset(TILT_KEYS) | frozenset(LIFT_KEYS)
+
+
+class Interaction:
+    """What the user's hands are doing to one Simulation: a held ball, a selected plane, the shot speed."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self.shot_speed = DEFAULT_SHOT_SPEED
+        self.clock = 0.0  # seconds of frames so far; throw velocities are measured on it
+        self.held_ball: int | None = None
+        self.selected_plane: int | None = None
+        self.pointer = (0.0, 0.0)
+        self.target = np.zeros(3)  # where the held ball's centre goes
+        self._offset = np.zeros(3)  # ball centre minus the point under the pointer
+        self._samples: deque[tuple[float, np.ndarray]] = deque()
+        self._base_motion = (np.zeros(3), np.zeros(3))  # the selected plane's own (velocity, spin)
+        sim.before_step.append(self._hold)
+        sim.after_step.append(self._hold)
+        sim.after_reset.append(self.clear)
+
+    # ------------------------------------------------------------------ pointer
+    def press(self, ray: Ray, x: float, y: float, facing: np.ndarray) -> str:
+        """Left button down at window point (x, y): pick up a ball (to move in the plane through it
+        with normal ``facing``, the view direction), select a plane, or (on nothing) deselect. Returns
+        what happened, for the HUD."""
+        hit = pick(ray, self.sim.world)
+        if hit is None:
+            self.deselect()
+            return ""
+        if hit.kind == "plane":
+            self.select(hit.index)
+            return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+        ball = self.sim.world.spheres[hit.index]
+        centre = np.array(ball.position, dtype=float)
+        grabbed = ray_plane_point(ray, centre, np.asarray(facing, dtype=float))
+        self.held_ball = hit.index
+        self.pointer = (float(x), float(y))
+        self._offset = centre - (grabbed if grabbed is not None else centre)
+        self.target = centre
+        self._samples.clear()
+        self._samples.append((self.clock, centre.copy()))
+        return ""
+
+    def move(self, x: float, y: float) -> None:
+        """The pointer moved (with the left button down)."""
+        self.pointer = (float(x), float(y))
+
+    def release(self) -> np.ndarray | None:
+        """Left button up: let go of a held ball with the drag's velocity (returned), if one is held."""
+        if self.held_ball is None:
+            return None
+        velocity = self.throw_velocity()
+        ball = self.sim.world.spheres[self.held_ball]
+        ball.position = self.target
+        ball.velocity = velocity
+        ball.angular_velocity = (0.0, 0.0, 0.0)
+        self.held_ball = None
+        self._samples.clear()
+        return velocity
+
+    def throw_velocity(self) -> np.ndarray:
+        """The held ball's velocity: its motion over the last ``THROW_WINDOW`` seconds of frames."""
+        if len(self._samples) < 2:
+            return np.zeros(3)
+        (t0, p0), (t1, p1) = self._samples[0], self._samples[-1]
+        return (p1 - p0) / (t1 - t0) if t1 > t0 else np.zeros(3)
+
+    # ------------------------------------------------------------------ per frame
+    def update(self, camera: Camera, size: tuple[int, int], held_keys: Iterable[str], seconds: float) -> None:
+        """Once per frame, before physics: move the held ball's target to the pointer and drive the
+        selected plane from the held keys."""
+        self.clock += max(float(seconds), 0.0)
+        if self.held_ball is not None:
+            self._follow_pointer(camera, size)
+        if self.selected_plane is not None:
+            self._drive_plane(camera, set(held_keys))
+
+    def _follow_pointer(self, camera: Camera, size: tuple[int, int]) -> None:
+        ray = pointer_ray(camera, *self.pointer, *size)
+        normal = camera.forward
+        offset = self._offset - np.dot(self._offset, normal) * normal
+        hit = ray_plane_point(ray, self.target, normal)
+        if hit is None or np.dot(hit - ray.origin, ray.direction) <= 0.0:
+            return  # the pointer is above the horizon of the drag plane: leave the ball where it is
+        self.target = hit + offset
+        self._samples.append((self.clock, self.target.copy()))
+        while len(self._samples) > 2 and self._samples[1][0] <= self.clock - THROW_WINDOW:
+            self._samples.popleft()
+        if self.sim.phase is not Phase.RUNNING:  # no steps to carry it: place it now
+            ball = self.sim.world.spheres[self.held_ball]
+            ball.position = self.target
+            ball.velocity = (0.0, 0.0, 0.0)
+            ball.angular_velocity = (0.0, 0.0, 0.0)
+
+    def _hold(self) -> None:
+        """Step hook: a held ball sits at the pointer's point, moving with the drag's velocity."""
+        if self.held_ball is None:
+            return
+        ball = self.sim.world.spheres[self.held_ball]
+        ball.position = self.target
+        ball.velocity = self.throw_velocity()
+        ball.angular_velocity = (0.0, 0.0, 0.0)
+
+    # ------------------------------------------------------------------ planes
+    def select(self, index: int) -> None:
+        """Select plane ``index`` (deselecting any other)."""
+        if self.selected_plane == index:
+            return
+        self.deselect()
+        plane = self.sim.world.planes[index]
+        self.selected_plane = index
+        self._base_motion = (np.array(plane.velocity, dtype=float), np.array(plane.angular_velocity))
+
+    def deselect(self) -> bool:
+        """Deselect the selected plane, giving it back its own motion. False if none was selected."""
+        if self.selected_plane is None:
+            return False
+        plane = self.sim.world.planes[self.selected_plane]
+        plane.velocity, plane.angular_velocity = self._base_motion
+        self.selected_plane = None
+        return True
+
+    def _drive_plane(self, camera: Camera, held: set[str]) -> None:
+        right, _, _ = camera_basis(camera)
+        axes = {"right": right, "forward": np.cross(WORLD_UP, right)}
+        velocity, spin = (m.copy() for m in self._base_motion)
+        for name in held & PLANE_KEYS:
+            if name in TILT_KEYS:
+                axis, sign = TILT_KEYS[name]
+                spin += sign * TILT_RATE * axes[axis]
+            else:
+                velocity += LIFT_KEYS[name] * LIFT_SPEED * WORLD_UP
+        plane = self.sim.world.planes[self.selected_plane]
+        plane.velocity, plane.angular_velocity = velocity, spin
+
+    def own_motion(self) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """The selected plane's own (velocity, angular velocity), without what held keys add to it."""
+        return {} if self.selected_plane is None else {self.selected_plane: self._base_motion}
+
+    def takes_key(self, name: str) -> bool:
+        """Whether a key press belongs to the selected plane (arrows, PgUp, PgDn) rather than its action."""
+        return self.selected_plane is not None and name in PLANE_KEYS
+
+    # ------------------------------------------------------------------ shooting
+    def next_shot_speed(self) -> float:
+        """Shift+B: the next shot speed, round the list."""
+        bigger = [s for s in SHOT_SPEEDS if s > self.shot_speed]
+        self.shot_speed = bigger[0] if bigger else SHOT_SPEEDS[0]
+        return self.shot_speed
+
+    def shoot(self, camera: Camera) -> int:
+        """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index.
+        It is as big and heavy as the scene's typical (median) ball."""
+        spheres = self.sim.world.spheres
+        radius = float(np.median(spheres.radii)) if len(spheres) else SHOT_RADIUS
+        mass = float(np.median(spheres.masses)) if len(spheres) else SHOT_MASS
+        forward = camera.forward
+        start = np.asarray(camera.position, dtype=float) + forward * (2.0 * radius + camera.near)
+        color = palette_colors(1, first=len(spheres))[0]
+        return self.sim.add_ball(
+            color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed
+        )
+
+    # ------------------------------------------------------------------ state
+    def clear(self) -> None:
+        """Reset hook: the world was replaced, so let go of everything (nothing to give back)."""
+        self.held_ball = None
+        self.selected_plane = None
+        self._samples.clear()
+
+    def lines(self) -> np.ndarray:
+        """The throw arrow from the held ball along its throw velocity, as overlay line vertices."""
+        if self.held_ball is None:
+            return overlays.empty()
+        arrow = overlays.velocity_arrows(self.target[None, :], self.throw_velocity()[None, :])
+        arrow[:, 3:] = THROW_COLOR
+        return arrow
+
+    def hud_lines(self) -> list[str]:
+        """What the HUD says about reaching in."""
+        lines = []
+        if self.held_ball is not None:
+            speed = float(np.linalg.norm(self.throw_velocity()))
+            lines.append(f"holding     ball {self.held_ball}, throw {speed:.2f} m/s")
+        if self.selected_plane is not None:
+            lines.append(f"selected    plane #{self.selected_plane + 1}: arrows PgUp PgDn")
+        return lines

@@ -1,0 +1,159 @@
+"""What a Simulation remembers and compares: the history you scrub, a replayed trajectory, the
+integrator ghosts and the energy trace.
+
+``Timeline`` is the one object the Simulation calls into: ``step`` takes a live step (and records it,
+and steps the ghosts) or plays a replay on; ``back``, ``forward``, ``jump`` and ``scrub`` move in time
+while paused; ``toggle_ghosts`` starts or stops the ghosts. No GL here.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .energyplot import EnergyTrace
+from .ghosts import CATCH_UP_STEPS, Ghosts, total_energy
+from .history import History
+from .replay import Replay, Trajectory
+
+if TYPE_CHECKING:
+    from .simulation import Simulation
+
+JUMP_SECONDS = 1.0  # Shift+← / Shift+→
+
+
+class Timeline:
+    """History (live runs) or Replay (trajectories), ghosts and the energy trace of one Simulation."""
+
+    def __init__(self, sim: Simulation, trajectory: Trajectory | None = None) -> None:
+        self.sim = sim
+        self.history: History | None = None
+        self.replay: Replay | None = Replay(sim.world, trajectory) if trajectory is not None else None
+        self.ghosts: Ghosts | None = None
+        self.energy = EnergyTrace()
+        self._origin: Any = None  # the drop's snapshot, for ghosts started later
+
+    # ------------------------------------------------------------------ state
+    @property
+    def source(self) -> History | Replay | None:
+        """What ←/→ and the timeline bar move through: the replay, else the live history."""
+        return self.replay if self.replay is not None else self.history
+
+    @property
+    def steps_per_second(self) -> float:
+        source = self.source
+        return 1.0 / source.timestep if source is not None else 1.0 / self.sim.timestep
+
+    def span(self) -> tuple[float, float, float] | None:
+        """(oldest, current, newest) seconds of the span kept, or None before the drop."""
+        s = self.source
+        if s is None:
+            return None
+        return s.time_of(s.first), s.time_of(s.current), s.time_of(s.latest)
+
+    # ------------------------------------------------------------------ live
+    def started(self) -> None:
+        """X: the drop. A live run starts its history here."""
+        if self.replay is None and self.history is None:
+            self.history = History(self.sim.world, self.sim.timestep)
+            self._origin = self.sim.world.snapshot()
+            if self.ghosts is not None:  # G before X: the ghosts start with the drop
+                self.ghosts = Ghosts(self.sim.world, self._origin, 0, self.history)
+
+    def step(self, dt: float) -> Any:
+        """One fixed step: the physics (recorded, ghosts alongside) or the next replay frame."""
+        world = self.sim.world
+        if self.replay is not None:
+            if not self.replay.advance(dt):
+                self.sim.end_of_replay()
+            return _no_contacts()
+        contacts = world.step(dt)
+        if self.history is not None:
+            self.history.recorded(world.integrator)
+        if self.ghosts is not None:
+            self.ghosts.stepped()
+        return contacts
+
+    def resumed(self) -> bool:
+        """Space while paused in the past: drop the future (true when something was dropped)."""
+        h = self.history
+        if h is None or not h.in_past:
+            return False
+        h.drop_future()
+        return True
+
+    # ------------------------------------------------------------------ moving in time
+    def seek(self, step: int) -> bool:
+        """Go to ``step`` of the source; the ghosts follow. False when there is nothing to move in."""
+        source = self.source
+        if source is None:
+            return False
+        source.seek(step)
+        if self.ghosts is not None:
+            self.ghosts.seek(source.current)
+        self.sim.after_seek(getattr(source, "last_contacts", None))
+        return True
+
+    def back(self) -> bool:
+        s = self.source
+        return s is not None and self.seek(s.current - 1)
+
+    def forward(self) -> bool:
+        """→ / N while paused: one step forward through what is kept (False at the newest step)."""
+        s = self.source
+        if s is None or s.current >= s.latest:
+            return False
+        return self.seek(s.current + 1)
+
+    def jump(self, seconds: float) -> bool:
+        s = self.source
+        return s is not None and self.seek(s.current + round(seconds * self.steps_per_second))
+
+    def scrub(self, fraction: float) -> bool:
+        s = self.source
+        if s is None:
+            return False
+        fraction = float(np.clip(fraction, 0.0, 1.0))
+        return self.seek(s.first + round(fraction * (s.latest - s.first)))
+
+    # ------------------------------------------------------------------ ghosts
+    def toggle_ghosts(self) -> str:
+        """G: start or stop the ghosts; returns the message for the HUD."""
+        if self.ghosts is not None:
+            self.ghosts = None
+            return "ghosts off"
+        if self.replay is not None:
+            return "ghosts need a live run, not a replay"
+        world = self.sim.world
+        h = self.history
+        if h is None:  # before the drop: they start with it
+            self.ghosts = Ghosts(world, world.snapshot(), 0, None)
+            return "ghosts on: they drop with X"
+        if h.current <= CATCH_UP_STEPS and h.first == 0:
+            self.ghosts = Ghosts(world, self._origin, 0, h)
+            return "ghosts on: energy drift since the drop"
+        self.ghosts = Ghosts(world, world.snapshot(), h.current, h)
+        return f"ghosts on: energy drift since t = {world.time:.2f} s"
+
+    def drifts(self) -> list[tuple[str, float, bool]]:
+        return self.ghosts.drifts(self.sim.world) if self.ghosts is not None else []
+
+    def ghost_worlds(self) -> list[tuple[str, Any]]:
+        return list(self.ghosts.worlds.items()) if self.ghosts is not None else []
+
+    # ------------------------------------------------------------------ energy
+    def sample_energy(self) -> None:
+        """One sample of the energy trace at the world's time (once per frame)."""
+        world = self.sim.world
+        kinetic, potential = world.kinetic_energy(), world.potential_energy()
+        totals = {world.integrator: kinetic + potential}
+        for name, ghost in self.ghost_worlds():
+            totals[name] = total_energy(ghost)
+        self.energy.add(world.time, kinetic, potential, totals)
+
+
+def _no_contacts() -> Any:
+    from ballpit import Contacts
+
+    return Contacts.empty()

@@ -1,0 +1,229 @@
+"""Scenarios for the history, replay, ghosts and energy plot, in a real viewer window under Xvfb.
+
+Run as ``python history_driver.py SCENARIO WORKDIR`` (test_history_window.py does this). Keys go in as
+pyglet events dispatched into the real window; the timeline is scrubbed with real X pointer events
+from xdotool. The last stdout line is ``RESULT <json>``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import window_driver as wd
+
+import ballpit
+from ballpit.viewer.screen import plot_rect, timeline_bar
+
+DT = 1 / 240  # the default timestep of a world built in code
+
+
+def digest(world: ballpit.World) -> str:
+    """Every ball's full state and the time, bit for bit."""
+    return hashlib.sha256(world.state.body.tobytes() + np.float64(world.time).tobytes()).hexdigest()
+
+
+def reference_digests(make, steps: int, integrator: str | None = None) -> list[str]:
+    """The state after 0, 1, ..., ``steps`` steps of a plain headless run."""
+    world = make()
+    if integrator:
+        world.integrator = integrator
+    out = [digest(world)]
+    for _ in range(steps):
+        world.step(DT)
+        out.append(digest(world))
+    return out
+
+
+def bounce_world() -> ballpit.World:
+    """A frictionless ball bouncing on a perfectly elastic ground: the energy is conserved exactly."""
+    world = ballpit.World(integrator="rk4")
+    world.add_plane(position=(0, 0, 0), restitution=1.0, friction=0.0)
+    world.add_sphere(position=(0, 2.0, 0), radius=0.25, restitution=1.0, friction=0.0)
+    return world
+
+
+def press_xdotool_drag(viewer, x0: float, x1: float, y: float) -> None:
+    """A real left-button drag along the window from x0 to x1 at height y (pyglet's y, from the bottom)."""
+    wid = str(viewer.window._window)
+    top = viewer.window.height - y
+    wd.xdotool("mousemove", "--window", wid, str(int(x0)), str(int(top)))
+    wd.settle(viewer, 3)
+    wd.xdotool("mousedown", "1")
+    wd.settle(viewer, 3)
+    for x in np.linspace(x0, x1, 5)[1:]:
+        wd.xdotool("mousemove", "--window", wid, str(int(x)), str(int(top)))
+        wd.settle(viewer, 2)
+    wd.xdotool("mouseup", "1")
+    wd.settle(viewer, 3)
+
+
+def bar_pixels(viewer) -> int:
+    """How many pixels along the timeline bar's row have its colours (drawn, not just computed)."""
+    image = wd.grab(viewer)
+    x, y, w, h = timeline_bar(viewer.window.width)
+    row = image[viewer.window.height - int(y + h / 2), int(x) : int(x + w)]
+    return int((row[:, 2] > row[:, 0] + 40).sum())  # the blue of the bar over a dark background
+
+
+# ---------------------------------------------------------------------- scenarios
+def history_keys(workdir: Path) -> dict:
+    from pyglet.window import key
+
+    viewer = wd.open_viewer(size=(640, 360), world=wd.balls_world())
+    sim = viewer.sim
+    reference = reference_digests(wd.balls_world, 600)
+    wd.pump(viewer, 2)
+    out: dict = {"bar_before_drop": bar_pixels(viewer)}
+    wd.press(viewer, "X", frames=90)  # 1.5 s: 360 steps
+    wd.press(viewer, "SPACE")
+    h = sim.timeline.history
+    out["paused_at"] = h.current
+    out["paused_matches"] = digest(sim.world) == reference[h.current]
+    checks = []
+
+    def check(label: str) -> None:
+        checks.append([label, h.current, digest(sim.world) == reference[h.current]])
+
+    for _ in range(3):
+        wd.press(viewer, "LEFT")
+        check("left")
+    wd.press(viewer, "LEFT", modifiers=key.MOD_SHIFT)
+    check("shift+left")
+    wd.press(viewer, "RIGHT")
+    check("right")
+    wd.press(viewer, "N")
+    check("n")
+    wd.press(viewer, "RIGHT", modifiers=key.MOD_SHIFT)
+    check("shift+right")
+    out["checks"] = checks
+    out["latest"] = h.latest
+    out["bar_pixels"] = bar_pixels(viewer)
+    out["labels"] = [c.label for c in viewer.renderer.draws.calls]
+
+    wd.point_at(viewer)
+    x, y, w, bh = timeline_bar(viewer.window.width)
+    press_xdotool_drag(viewer, x + 0.8 * w, x + 0.25 * w, y + bh / 2)  # real pointer: drag back to 25 %
+    out["scrubbed_to"] = h.current
+    out["scrub_expected"] = round(0.25 * h.latest)
+    out["scrub_matches"] = digest(sim.world) == reference[h.current]
+    out["scrub_phase"] = sim.phase.name
+    out["hud"] = viewer.hud.text
+
+    resumed_from = h.current
+    wd.press(viewer, "SPACE")  # resume from the past: the future is dropped
+    out["after_resume_latest"] = h.latest
+    out["resumed_from"] = resumed_from
+    wd.pump(viewer, 20)
+    wd.press(viewer, "SPACE")
+    out["rerun_at"] = h.current
+    out["rerun_matches"] = digest(sim.world) == reference[h.current]
+    return out
+
+
+def ghosts_and_plot(workdir: Path) -> dict:
+    viewer = wd.open_viewer(size=(800, 450), world=bounce_world())
+    sim = viewer.sim
+    wd.press(viewer, "G")  # before the drop: the ghosts drop with X
+    wd.press(viewer, "P")
+    wd.press(viewer, "X", frames=180)  # 3 s: two bounces
+    wd.press(viewer, "SPACE")
+    steps = sim.timeline.history.current
+    out: dict = {"steps": steps, "drifts": sim.timeline.drifts()}
+    # the same drift, worked out headless: the run and two plain copies under the other integrators
+    expected = {}
+    for name in ("rk4", "euler", "rk2"):
+        world = bounce_world()
+        e0 = world.kinetic_energy() + world.potential_energy()
+        world.integrator = name
+        for _ in range(steps):
+            world.step(DT)
+        expected[name] = ((world.kinetic_energy() + world.potential_energy()) - e0) / abs(e0) * 100
+    out["expected"] = expected
+    wd.pump(viewer, 1, dt=0.0)
+    out["hud"] = viewer.hud.text
+    out["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
+    image = wd.grab(viewer)
+    x, y, w, h = plot_rect(viewer.window.width, viewer.window.height)
+    top = viewer.window.height - int(y + h)
+    region = image[top : top + int(h), int(x) : int(x + w)]
+    tints = {"euler": (255, 97, 77), "rk4": (89, 204, 255)}
+    out["plot_pixels"] = {
+        name: int((np.abs(region - np.array(c)).max(axis=-1) < 40).sum()) for name, c in tints.items()
+    }
+    green = (region[..., 1] > 180) & (region[..., 0] < 150) & (region[..., 2] < 150)
+    out["kinetic_pixels"] = int(green.sum())
+    series = sim.timeline.energy.series()
+    out["series"] = sorted(series)
+    out["span"] = float(series["time"][-1] - series["time"][0])
+    ghost = sim.timeline.ghosts
+    # stepping back moves the ghosts too
+    wd.press(viewer, "LEFT")
+    out["ghost_steps_after_left"] = [g.current for g in ghost.histories.values()]
+    wd.press(viewer, "G")
+    wd.pump(viewer, 1, dt=0.0)
+    out["calls_off"] = [c.label for c in viewer.renderer.draws.calls]
+    return out
+
+
+def replay(workdir: Path) -> dict:
+    from ballpit.viewer.replay import read_trajectory
+
+    scene = Path(sys.argv[3])
+    trajectory = read_trajectory(workdir / sys.argv[4])
+    viewer = wd.open_viewer(
+        size=(640, 360), scene_path=scene, trajectory=read_trajectory(workdir / sys.argv[4])
+    )
+    sim = viewer.sim
+    rp = sim.timeline.replay
+
+    def frame_matches() -> bool:
+        return bool(np.array_equal(np.asarray(sim.world.spheres.positions), trajectory.position[rp.current]))
+
+    out: dict = {"phase": sim.phase.name, "frames": trajectory.frames, "first": [rp.current, frame_matches()]}
+    wd.pump(viewer, 30)  # 0.5 s
+    out["after_half_second"] = [rp.current, float(sim.world.time), frame_matches()]
+    wd.press(viewer, "SPACE")
+    at = rp.current
+    wd.pump(viewer, 10)
+    out["paused_still"] = rp.current == at
+    wd.press(viewer, "LEFT")
+    out["left"] = [at, rp.current, frame_matches()]
+    wd.press(viewer, "RIGHT")
+    wd.press(viewer, "RIGHT")
+    out["right_twice"] = [rp.current, frame_matches()]
+    wd.point_at(viewer)
+    x, y, w, bh = timeline_bar(viewer.window.width)
+    press_xdotool_drag(viewer, x + 0.5 * w, x + 0.1 * w, y + bh / 2)
+    out["scrub"] = [rp.current, rp.latest, frame_matches()]
+    wd.type_text(viewer, "+")  # time ×2
+    wd.press(viewer, "SPACE")
+    t0 = float(sim.world.time)
+    wd.pump(viewer, 30)
+    out["fast"] = [float(sim.world.time) - t0, sim.time_scale, frame_matches()]
+    wd.pump(viewer, 400)
+    out["end"] = [rp.current, rp.latest, sim.phase.name]
+    out["hud"] = viewer.hud.text
+    return out
+
+
+SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay)}
+
+
+def main() -> None:
+    scenario, workdir = sys.argv[1], Path(sys.argv[2])
+    result = SCENARIOS[scenario](workdir)
+    for viewer in wd.OPENED:
+        viewer.close()
+        viewer.pump()
+    print("RESULT " + json.dumps(result), flush=True)
+
+
+if __name__ == "__main__":
+    main()

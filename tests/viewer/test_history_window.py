@@ -1,0 +1,100 @@
+"""History keys and scrubbing, replay, integrator ghosts and the energy plot in real windows under Xvfb
+(history_driver.py runs each scenario in its own process)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from .conftest import REPO, subprocess_env
+
+DRIVER = Path(__file__).with_name("history_driver.py")
+
+
+def run_scenario(display: str, name: str, workdir: Path, *extra: str) -> dict:
+    proc = subprocess.run(
+        [sys.executable, str(DRIVER), name, str(workdir), *extra],
+        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
+    assert lines, proc.stdout + proc.stderr
+    return json.loads(lines[-1][len("RESULT ") :])
+
+
+def test_arrow_keys_and_a_dragged_timeline_move_through_the_history_exactly(xvfb, tmp_path):
+    r = run_scenario(xvfb, "history_keys", tmp_path)
+    assert r["bar_before_drop"] == 0  # no timeline before the drop
+    assert r["paused_at"] == 360 and r["paused_matches"]
+    # every stop is the state a plain headless run had at that step, bit for bit
+    assert r["checks"] == [["left", 359, True], ["left", 358, True], ["left", 357, True],
+                           ["shift+left", 117, True], ["right", 118, True], ["n", 119, True],
+                           ["shift+right", 359, True]]  # fmt: skip
+    assert r["latest"] == 360  # going back and forth through the history keeps it
+    assert r["bar_pixels"] > 300  # the bar is drawn along the bottom
+    assert "screen panels" in r["labels"]
+    # a real pointer drag on the bar scrubs (and pauses)
+    assert r["scrubbed_to"] == r["scrub_expected"] and r["scrub_matches"]
+    assert r["scrub_phase"] == "PAUSED"
+    assert "in the past" in r["hud"]
+    # resuming from the past drops the future; the re-run still equals the plain run
+    assert r["resumed_from"] <= r["after_resume_latest"] < r["resumed_from"] + 10
+    assert r["rerun_at"] > r["resumed_from"] and r["rerun_matches"]
+
+
+def test_ghosts_show_each_integrators_drift_and_the_plot_draws_it(xvfb, tmp_path):
+    r = run_scenario(xvfb, "ghosts_and_plot", tmp_path)
+    assert r["steps"] == 720
+    drifts = {name: (drift, main) for name, drift, main in r["drifts"]}
+    assert drifts["rk4"][1] and not drifts["euler"][1] and not drifts["rk2"][1]
+    # identical to the same runs done headless
+    for name, expected in r["expected"].items():
+        assert drifts[name][0] == pytest.approx(expected, rel=1e-12, abs=1e-12)
+    # a frictionless elastic bounce: RK4 (and midpoint RK2: exact for constant gravity) hold the energy;
+    # explicit Euler gains about g·dt of speed per flight, a few % over two bounces from 2 m
+    assert abs(drifts["rk4"][0]) < 1e-6 and abs(drifts["rk2"][0]) < 1e-6
+    assert 1.0 < drifts["euler"][0] < 6.0
+    assert "E drift ghost Euler" in r["hud"] and "+3.06" in r["hud"]
+    calls = dict((label, n) for label, n in r["calls"])
+    assert calls["balls"] == 1 and calls["ghosts"] == 2  # one instanced call for both ghost sets
+    assert [label for label, _ in r["calls"]].count("balls") == 1
+    assert "screen lines" in calls
+    assert r["plot_pixels"]["euler"] > 20 and r["plot_pixels"]["rk4"] > 20  # one total line per integrator
+    assert r["kinetic_pixels"] > 50
+    assert r["series"] == ["kinetic", "potential", "time", "total euler", "total rk2", "total rk4"]
+    assert r["span"] == pytest.approx(3.0, abs=0.05)
+    assert r["ghost_steps_after_left"] == [719, 719]  # the ghosts step back with the run
+    assert "ghosts" not in r["calls_off"]
+
+
+@pytest.fixture
+def slopes_run(tmp_path) -> Path:
+    out = tmp_path / "run.npz"
+    proc = subprocess.run(
+        [sys.executable, "-m", "ballpit", "simulate", str(REPO / "scenes" / "slopes.toml"), "--duration", "2",
+         "--out", str(out), "-q"],
+        env=subprocess_env(None), capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_a_simulate_trajectory_replays_with_pause_step_scrub_and_time_scale(xvfb, tmp_path, slopes_run):
+    r = run_scenario(xvfb, "replay", tmp_path, str(REPO / "scenes" / "slopes.toml"), slopes_run.name)
+    assert r["phase"] == "RUNNING" and r["first"] == [0, True]
+    frame, time, matches = r["after_half_second"]
+    assert 118 <= frame <= 120 and matches and time == pytest.approx(frame / 240, abs=1e-6)
+    assert r["paused_still"]
+    assert r["left"][1] == r["left"][0] - 1 and r["left"][2]
+    assert r["right_twice"] == [r["left"][1] + 2, True]
+    current, latest, matches = r["scrub"]
+    assert latest == 480 and current == round(0.1 * latest) and matches
+    elapsed, scale, matches = r["fast"]
+    assert scale == 2.0 and elapsed == pytest.approx(1.0, abs=0.02) and matches  # 0.5 s of frames at ×2
+    assert r["end"] == [480, 480, "PAUSED"]
+    assert "replay      run.npz" in r["hud"]

@@ -1,0 +1,164 @@
+"""Ctrl+S's writer without a window: the saved file keeps the original's comments, never overwrites,
+and loads back (``ballpit check`` too) into the same World as the one saved."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import ballpit
+from ballpit.viewer.camera import Camera
+from ballpit.viewer.save import euler_xyz_degrees, save_scene, saved_path
+from ballpit.viewer.simulation import Simulation
+
+from .conftest import subprocess_env
+
+SCENE = """# A test scene: a ramp, a ball and a grid.
+[world]
+integrator = "rk4"   # the live choice may differ
+timestep = 0.004166667
+
+[camera]
+position = [0, 3, 10]
+look_at = [0, 1, 0]
+
+[[plane]]                   # the ground
+normal = [0, 1, 0]
+
+[[plane]]                   # the ramp that gets tilted
+position = [0, 1, 0]
+rotation = [0, 0, 10]
+size = [4, 3]
+restitution = 0.3
+
+[[sphere]]                  # the lone ball
+position = [0.2, 1.6, 0]
+radius = 0.25
+color = "#e0482f"
+
+[[grid]]                    # a small block
+corner = [-1, 3, 0]
+count = [2, 1, 2]
+radius = 0.2
+"""
+
+
+def _states(world) -> dict[str, np.ndarray]:
+    s, p = world.spheres, world.planes
+    return {
+        "positions": np.array(s.positions), "velocities": np.array(s.velocities),
+        "angular_velocities": np.array(s.angular_velocities), "orientations": np.array(s.orientations),
+        "radii": np.array(s.radii), "masses": np.array(s.masses),
+        "ball_materials": np.array([[b.restitution, b.friction, b.rolling_friction, b.hollow] for b in s]),
+        "plane_centers": np.array(p.centers), "plane_orientations": np.array(p.orientations),
+        "plane_normals": np.array(p.normals), "half_sizes": np.array(p.half_sizes),
+        "plane_materials": np.array([[q.restitution, q.friction, q.rolling_friction] for q in p]),
+        "plane_motion": np.hstack([p.velocities, p.angular_velocities]),
+    }  # fmt: skip
+
+
+def assert_same_world(saved, live) -> None:
+    a, b = _states(saved), _states(live)
+    for key in ("positions", "velocities", "angular_velocities", "radii", "masses", "ball_materials",
+                "plane_materials", "plane_motion", "half_sizes"):  # fmt: skip
+        assert np.array_equal(a[key], b[key]), key  # the same doubles
+    assert np.allclose(a["orientations"], b["orientations"], rtol=0, atol=1e-15)  # renormalised on load
+    for key in ("plane_centers", "plane_orientations", "plane_normals"):  # through Euler angles
+        assert np.allclose(a[key], b[key], rtol=0, atol=1e-12), key
+    assert saved.integrator == live.integrator
+    assert np.array_equal(saved.gravity, live.gravity)
+
+
+@pytest.mark.parametrize("angles", [(0, 0, 0), (10, -20, 30), (90, 45, 0), (-170, 89.9, 120), (0, 90, 0)])
+def test_euler_angles_read_back_to_the_same_rotation(angles):
+    q = Rotation.from_euler("xyz", angles, degrees=True).as_quat()
+    back = Rotation.from_euler("xyz", euler_xyz_degrees(q), degrees=True)
+    assert np.allclose(back.as_matrix(), Rotation.from_quat(q).as_matrix(), atol=1e-12)
+
+
+def test_saved_names_count_up_beside_the_original_and_never_overwrite(tmp_path):
+    original = tmp_path / "ramp.toml"
+    assert saved_path(original) == tmp_path / "ramp-saved-1.toml"
+    (tmp_path / "ramp-saved-1.toml").write_text("")
+    assert saved_path(original) == tmp_path / "ramp-saved-2.toml"
+    assert saved_path(tmp_path / "ramp-saved-1.toml") == tmp_path / "ramp-saved-2.toml"
+
+
+def test_a_tilted_plane_moved_balls_and_an_added_ball_save_and_load_back_the_same(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(ballpit.load_scene(path), path)
+    world = sim.world
+    world.integrator = "rk2"
+    world.planes[1].angular_velocity = (0.0, 0.0, 0.3)
+    world.planes[1].velocity = (0.0, 0.2, 0.0)
+    for _ in range(100):
+        world.step(sim.timestep)
+    world.planes[1].angular_velocity = (0.0, 0.0, 0.0)
+    world.planes[1].velocity = (0.0, 0.0, 0.0)
+    sim.add_ball((0.1, 0.2, 0.3), position=(2.0, 4.0, 1.0), radius=0.3, mass=2.0, velocity=(1.0, 2.0, 3.0))
+    camera = Camera.looking_at((1.0, 2.0, 8.0), (0.0, 1.0, 0.0))
+
+    saved = save_scene(sim, camera)
+    assert saved == tmp_path / "ramp-saved-1.toml"
+    assert save_scene(sim, camera) == tmp_path / "ramp-saved-2.toml"  # never overwrites
+    assert path.read_text() == SCENE  # the original is untouched
+    text = saved.read_text()
+    for comment in ("# A test scene", "# the ground", "# the ramp that gets tilted", "# the lone ball",
+                    "# the live choice may differ"):  # fmt: skip
+        assert comment in text, comment
+    assert "[[grid]]" not in text  # its balls moved: they are spheres now
+    loaded = ballpit.load_scene(saved)
+    assert len(loaded.spheres) == 1 + 4 + 1
+    assert_same_world(loaded, world)
+    assert np.allclose(loaded.scene.camera_position, camera.position)
+    look = loaded.scene.camera_look_at - loaded.scene.camera_position
+    assert np.allclose(look / np.linalg.norm(look), camera.forward)
+    assert np.allclose(loaded.scene.sphere_colors[-1], (0.1, 0.2, 0.3))
+
+    check = subprocess.run(
+        [sys.executable, "-m", "ballpit", "check", str(saved)], env=subprocess_env(None),
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert check.returncode == 0, check.stderr
+    assert "ok: 6 balls, 2 planes, rk2" in check.stdout
+
+
+def test_saving_before_the_drop_keeps_the_untouched_tables_and_adds_the_new_ball(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(ballpit.load_scene(path), path)
+    sim.add_ball((1.0, 0.0, 0.0), position=(2.0, 4.0, 1.0), radius=0.3, velocity=(0.0, 0.0, -10.0))
+    saved = save_scene(sim, Camera.looking_at((0, 3, 10), (0, 1, 0)))
+    text = saved.read_text()
+    assert text.count("[[sphere]]") == 1 + 4 + 1  # the grid's balls load after all spheres: written out
+    assert text.startswith(SCENE.split("[camera]")[0])  # the untouched top, comments and all
+    assert_same_world(ballpit.load_scene(saved), sim.world)
+
+
+def test_a_world_built_in_code_saves_everything(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    world = ballpit.World(gravity=(0, -3.0, 0), integrator="euler", linear_drag=0.1)
+    world.add_plane(position=(0, 0, 0))
+    world.add_plane(position=(1, 2, 0), rotation=(0, 20, 30), size=(2.0, 3.0), friction=0.2)
+    world.add_sphere(position=(0, 5, 0), radius=0.4, hollow=True, angular_velocity=(1, 2, 3))
+    sim = Simulation(world)
+    saved = save_scene(sim, Camera())
+    assert saved == tmp_path / "untitled-saved-1.toml"
+    loaded = ballpit.load_scene(saved)
+    assert_same_world(loaded, world)
+    assert loaded.linear_drag == 0.1
+
+
+def test_an_untouched_scene_saves_its_grid_as_a_grid(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(ballpit.load_scene(path), path)
+    saved = save_scene(sim, Camera.looking_at((0, 3, 10), (0, 1, 0)))
+    text = saved.read_text()
+    assert "[[grid]]" in text and text.count("[[sphere]]") == 1
+    assert_same_world(ballpit.load_scene(saved), sim.world)
