@@ -5,15 +5,25 @@
 // you look through (the near wall of a closed box seen from outside): the renderer draws it after the
 // balls, blended, so it is a faint, darker tint with its grid and rim kept visible. The selected plane
 // (clicked in the viewer) has a wide amber rim, or an amber tint if it is infinite and has no rim.
+//
+// The balls shade the front faces: each one near the ray towards the sun casts a soft-edged shadow,
+// and each one close by hides part of the sky (contact darkening). The renderer bins the balls in a
+// grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only its own cell.
 
 #include "common.glsl"
 
 in vec3 v_world;
 in vec2 v_local;
+in vec2 v_shadow_grid;                  // grid coordinates of v_world, from plane.vert
 flat in vec2 v_half_size;
 flat in vec3 v_normal;
 flat in vec3 v_color;
 flat in float v_selected;
+
+uniform samplerBuffer u_shadow_balls;   // centre xyz, radius; grouped by cell, nearest the sun first
+uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, cells[k].y)
+uniform vec2 u_shadow_shape;            // cells along u and v; (0, 0): no shadows
+uniform float u_shadow_reach;           // ball radii from the centre where a ball's shading ends
 
 out vec4 frag_color;
 
@@ -34,6 +44,39 @@ float grid(vec2 p, float spacing, float width_pixels) {
     float on = 1.0 - min(min(line.x, line.y) / width_pixels, 1.0);
     float density = max(w.x, w.y);
     return on * (1.0 - smoothstep(0.15, 0.5, density));
+}
+
+const float SUN_RADIUS = 0.035;        // radians: a disc a little wider than the real sun, soft edges
+
+// The balls near this point's ray towards the sun: the fraction of the sun it sees (x) and the
+// fraction of the ambient light the close ones leave (y). Its cell holds every ball that can shade it.
+// A CPU rasteriser runs the code after a per-pixel branch anyway (masked), so this is kept short, and
+// the grid coordinates come interpolated from the vertex shader.
+vec2 ball_shading(vec3 p, vec3 n, vec2 g) {
+    bool inside = all(greaterThanEqual(g, vec2(0.0))) && all(lessThan(g, u_shadow_shape));
+    ivec2 c = ivec2(clamp(g, vec2(0.0), max(u_shadow_shape - 1.0, vec2(0.0))));
+    ivec2 rows = inside ? texelFetch(u_shadow_cells, c.y * int(u_shadow_shape.x) + c.x).xy : ivec2(0);
+    bool lit_side = dot(n, u_sun_direction) > 0.0;
+    float sun = 1.0;
+    float ambient = 1.0;
+    for (int i = rows.x; i < rows.y; ++i) {
+        vec4 ball = texelFetch(u_shadow_balls, i);
+        float r = ball.w;
+        vec3 d = ball.xyz - p;
+        float l2 = dot(d, d);
+        float t = dot(d, u_sun_direction);          // along the ray to the sun
+        if (lit_side && t > 0.0) {
+            float miss = sqrt(max(l2 - t * t, 0.0));  // how far the ray passes from the centre
+            float w = min(t * SUN_RADIUS, (u_shadow_reach - 1.0) * r) + 1e-4;  // within reach
+            sun = min(sun, smoothstep(-w, w, miss - r));
+        }
+        // the sky the ball hides, cosine weighted: (r/l)^2 cos(theta), all of it where it touches
+        float l = sqrt(l2);
+        float hidden = max(dot(n, d), 0.0) / l * r * r / l2;
+        hidden *= 1.0 - smoothstep(0.6 * u_shadow_reach * r, u_shadow_reach * r, l);
+        ambient *= 1.0 - min(hidden, 1.0);
+    }
+    return vec2(sun, ambient);
 }
 
 void main() {
@@ -59,6 +102,7 @@ void main() {
         alpha = mix(mix(BACK_ALPHA, BACK_GRID_ALPHA, lines), BACK_EDGE_ALPHA, edge);
     }
 
-    vec3 color = shade(albedo, n, v_world, 24.0, 0.08);
+    vec2 shading = gl_FrontFacing ? ball_shading(v_world, n, v_shadow_grid) : vec2(1.0);
+    vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

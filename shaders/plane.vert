@@ -11,6 +11,10 @@ layout(location = 3) in vec3 a_normal;
 layout(location = 4) in vec3 a_color;
 
 uniform mat4 u_view_projection;
+uniform vec3 u_shadow_axis_u;           // the sun's grid (see plane.frag)
+uniform vec3 u_shadow_axis_v;
+uniform vec2 u_shadow_origin;
+uniform float u_shadow_inverse_cell;
 uniform float u_selected;
 
 out vec3 v_world;
@@ -18,10 +22,13 @@ out vec2 v_local;
 flat out vec2 v_half_size;
 flat out vec3 v_normal;
 flat out vec3 v_color;
+out vec2 v_shadow_grid;  // the position's grid coordinates: affine, so interpolating them is exact
 flat out float v_selected;
 
 void main() {
     v_world = a_position;
+    v_shadow_grid = (vec2(dot(a_position, u_shadow_axis_u), dot(a_position, u_shadow_axis_v)) - u_shadow_origin)
+                    * u_shadow_inverse_cell;
     v_local = a_local;
     v_half_size = a_half_size;
     v_normal = a_normal;

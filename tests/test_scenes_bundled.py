@@ -20,7 +20,7 @@ from ballpit.viewer.camera import Camera
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k"}
+REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw"}
 # Enough simulated time to exercise each scene while keeping the suite fast (big piles: a few steps).
 SHORT_RUN = {"pile": 3, "pile10k": 2, "gas": 3, "billiards": 20}  # steps
 DEFAULT_STEPS = 24
@@ -105,6 +105,31 @@ def test_cradle_passes_momentum_down_the_line(tmp_path):
     assert np.allclose(last[:5, 5], 0, atol=0.02), "the striker and the middle balls stop"
     assert last[5, 5] == pytest.approx(2.0, rel=0.01), "the far ball leaves at the striker's speed"
     assert (kinds == "sphere-sphere").sum() >= 5
+
+
+def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):
+    """The see-saw demo, judged from ``ballpit simulate`` output: the balls land on the plank, roll
+    left (downhill), turn back as it tips over, and leave its right end for the floor."""
+    traj, events, kinds = simulate_csv(tmp_path, "seesaw", "--duration", "5.5")
+    world = load_scene(SCENES / "seesaw.toml")
+    n = len(world.spheres)
+    assert n == 5
+    plank = world.planes[1]
+    assert np.any(plank.angular_velocity != 0) and plank.size == (5.0, 2.2)
+    t, x, y = (traj[:, k].reshape(-1, n) for k in (0, 2, 3))
+    radius = np.asarray(world.spheres.radii)
+    riding = (t[:, 0] > 0.7) & (t[:, 0] < 3.5)
+    assert (y[riding] > 2.0).all(), "no ball leaves the plank early"
+    leftmost = x.min(axis=0)
+    assert (leftmost < x[0] - 0.5).all(), "each ball first rolls left, downhill"
+    assert (leftmost > -2.3).all(), "and turns back before the plank's left end"
+    assert np.allclose(y[-1], radius, atol=0.01), "all on the floor at the end"
+    assert (x[-1] > 4.0).all(), "right of the plank's reach (2.5 m from its centre)"
+    plane_hits = events[kinds == "sphere-plane"]
+    on_plank, on_floor = plane_hits[plane_hits[:, 2] == 1], plane_hits[plane_hits[:, 2] == 0]
+    for ball in range(n):
+        assert on_plank[on_plank[:, 1] == ball, 0].min() < on_floor[on_floor[:, 1] == ball, 0].min()
+    assert on_floor[:, 0].min() > 4.0, "nothing reaches the floor before the plank has tipped"
 
 
 # --------------------------------------------------------------------------- the slopes demo

@@ -30,6 +30,7 @@ class FrameFeeder:
         self._generation: int | None = None
         self._sim: Simulation | None = None
         self._plane_pose = np.zeros((0, 7))
+        self.plane_uploads = 0  # how many times the plane quads were rebuilt (tests read it)
         self.upload_seconds = 0.0
 
     def upload(
@@ -52,6 +53,7 @@ class FrameFeeder:
             planes = world.planes
             self.renderer.set_planes(centers, plane_orientations, planes.half_sizes, look.plane_colors)
             self._sim, self._generation, self._plane_pose = sim, sim.generation, pose
+            self.plane_uploads += 1
         positions, orientations = sim.render_state()
         spheres = world.spheres
         self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors, eye)

@@ -9,6 +9,10 @@ Planes are drawn in two passes. Their front faces (the side the normal points to
 its balls) are opaque and drawn first. Their back faces are the walls you look through, such as the
 near wall of a closed box seen from outside, so they are drawn see-through after the balls (blended,
 not writing depth). The second pass is skipped when the eye is on the front side of every plane.
+
+The balls cast shadows onto the planes' front faces and darken them where they touch (see
+shadows.py): each frame the balls are binned in a grid seen from the sun, uploaded as two texture
+buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from OpenGL import GL
 
+from . import shadows
 from .camera import Camera
 from .overlays import VERTEX_WIDTH
 from .shaders import Program
@@ -31,6 +36,7 @@ NO_EDGE = 1.0e6  # "half size" given to the shader for infinite planes: no edge 
 BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), colour (3), spare
 PLANE_STRIDE = 13  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3)
 SORT_THRESHOLD = 256  # sort balls front to back above this many
+SHADOW_BALLS_UNIT, SHADOW_CELLS_UNIT = 1, 2  # texture units of the shadow grid's buffers
 _FLOAT = 4
 
 
@@ -109,6 +115,7 @@ class Renderer:
         _attribute(2, 4, BALL_STRIDE, 4, divisor=1)  # orientation
         _attribute(3, 4, BALL_STRIDE, 8, divisor=1)  # colour
         self._instances = np.zeros((0, BALL_STRIDE), dtype=np.float32)
+        self._sorted = np.zeros((0, BALL_STRIDE), dtype=np.float32)
         self.ball_count = 0
 
         # ghost balls (G): the same quad, their own instance buffer, drawn translucent after the balls
@@ -124,7 +131,7 @@ class Renderer:
         self.ghost_count = 0
         self.ghost_alpha = 0.4
 
-        # planes: two triangles each, rebuilt only when the scene changes
+        # planes: two triangles each, rebuilt when the scene changes or a plane moves
         self.plane_vao = GL.glGenVertexArrays(1)
         self.plane_vbo = GL.glGenBuffers(1)
         GL.glBindVertexArray(self.plane_vao)
@@ -135,6 +142,28 @@ class Renderer:
         self.selected_plane = -1  # drawn with a highlighted rim (or tint, if infinite); -1: none
         self._plane_centers = np.zeros((0, 3))
         self._plane_normals = np.zeros((0, 3))
+
+        # ball shadows: the grid of balls seen from the sun, two texture buffers the plane shader reads
+        self.shadows = True  # False: planes are drawn without ball shadows or contact darkening
+        self.sun_direction = np.asarray(shadows.SUN_DIRECTION, dtype=np.float32)
+        self.shadow_limit = shadows.LIMIT  # balls kept per grid cell
+        self.shadow_grid = shadows.empty_grid(self.sun_direction)
+        self.shadow_seconds = 0.0
+        self.shadow_buffers = GL.glGenBuffers(2)
+        self.shadow_textures = GL.glGenTextures(2)
+        for buffer, texture, fmt in zip(
+            self.shadow_buffers, self.shadow_textures, (GL.GL_RGBA32F, GL.GL_RG32I), strict=True
+        ):
+            GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_TEXTURE_BUFFER, 16, None, GL.GL_STREAM_DRAW)
+            GL.glBindTexture(GL.GL_TEXTURE_BUFFER, texture)
+            GL.glTexBuffer(GL.GL_TEXTURE_BUFFER, fmt, buffer)
+        GL.glBindTexture(GL.GL_TEXTURE_BUFFER, 0)
+        GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, 0)
+        self.plane_program.use()
+        self.plane_program.set_int("u_shadow_balls", SHADOW_BALLS_UNIT)
+        self.plane_program.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
+        GL.glUseProgram(0)
 
         # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
         self.line_vao = GL.glGenVertexArrays(1)
@@ -164,7 +193,7 @@ class Renderer:
     def set_planes(
         self, centers: np.ndarray, orientations: np.ndarray, half_sizes: np.ndarray, colors: np.ndarray
     ) -> None:
-        """Build the plane quads (call when the scene changes, not per frame)."""
+        """Build the plane quads: when the scene changes or a plane moved (a few planes: cheap)."""
         centers = np.asarray(centers, dtype=float).reshape(-1, 3)
         count = len(centers)
         q = np.asarray(orientations, dtype=float).reshape(-1, 4)
@@ -186,7 +215,7 @@ class Renderer:
         data[..., 7:10] = n[:, None, :]
         data[..., 10:13] = np.asarray(colors, dtype=float).reshape(-1, 3)[:, None, :]
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STATIC_DRAW)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.plane_vertices = count * 6
         self._plane_centers, self._plane_normals = centers, n
@@ -203,26 +232,44 @@ class Renderer:
 
         Given the ``eye``, many balls are ordered nearest first, so the depth test rejects the hidden
         ones before they are shaded (it halves the draw of a 10,000-ball pile on a CPU rasteriser).
+        The shadow grid is rebuilt from the same positions.
         """
         started = time.perf_counter()
+        self.upload_shadows(positions, radii)
         n = len(positions)
         if self._instances.shape[0] != n:
             self._instances = np.zeros((n, BALL_STRIDE), dtype=np.float32)
             self._instances[:, 11] = 1.0
+            self._sorted = np.zeros_like(self._instances)
         inst = self._instances
-        if eye is not None and n > SORT_THRESHOLD:
-            order = np.argsort(np.einsum("ij,ij->i", positions - eye, positions - eye))
-            positions, orientations = positions[order], orientations[order]
-            radii, colors = np.asarray(radii)[order], np.asarray(colors)[order]
         inst[:, 0:3] = positions
         inst[:, 3] = radii
         inst[:, 4:8] = orientations
         inst[:, 8:11] = colors
+        if eye is not None and n > SORT_THRESHOLD:  # in float32, then one gather of whole rows
+            offset = inst[:, 0:3] - np.asarray(eye, dtype=np.float32)
+            order = np.argsort(np.einsum("ij,ij->i", offset, offset))
+            inst = np.take(inst, order, axis=0, out=self._sorted)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.instance_vbo)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, inst.nbytes, inst if n else None, GL.GL_STREAM_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.ball_count = n
         self.upload_seconds = time.perf_counter() - started
+
+    def upload_shadows(self, positions: np.ndarray, radii: np.ndarray) -> None:
+        """Bin the balls in the sun's grid and upload it (two buffer uploads, whatever the count)."""
+        started = time.perf_counter()
+        if self.shadows and len(positions):
+            grid = shadows.build(positions, radii, self.sun_direction, limit=self.shadow_limit)
+        else:
+            grid = shadows.empty_grid(self.sun_direction)
+        for buffer, data in zip(self.shadow_buffers, (grid.balls, grid.ranges), strict=True):
+            GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_TEXTURE_BUFFER, max(data.nbytes, 16), data if data.nbytes else None,
+                            GL.GL_STREAM_DRAW)  # fmt: skip
+        GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, 0)
+        self.shadow_grid = grid
+        self.shadow_seconds = time.perf_counter() - started
 
     def upload_ghosts(
         self, positions: np.ndarray, orientations: np.ndarray, radii: np.ndarray, colors: np.ndarray,
@@ -269,8 +316,24 @@ class Renderer:
         program.set("u_eye", eye)
         program.set("u_background", self.background)
         program.set("u_fog_density", self.fog_density)
+        program.set("u_sun_direction", self.sun_direction)
         if program is self.plane_program:
             program.set("u_selected", int(self.selected_plane))
+
+    def _shadow_uniforms(self, program: Program) -> None:
+        """The sun's grid for the plane shader, with its buffers bound to their texture units."""
+        grid = self.shadow_grid
+        program.set("u_shadow_axis_u", grid.axes[0])
+        program.set("u_shadow_axis_v", grid.axes[1])
+        program.set("u_shadow_origin", grid.origin)
+        program.set("u_shadow_inverse_cell", 1.0 / grid.cell_size)
+        program.set("u_shadow_shape", np.array(grid.shape, dtype=np.float32))
+        program.set("u_shadow_reach", shadows.REACH)
+        for unit, texture in ((SHADOW_BALLS_UNIT, self.shadow_textures[0]),
+                              (SHADOW_CELLS_UNIT, self.shadow_textures[1])):  # fmt: skip
+            GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
+            GL.glBindTexture(GL.GL_TEXTURE_BUFFER, texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
 
     def seen_from_behind(self, eye: np.ndarray) -> np.ndarray:
         """Which planes have the eye on their back side (drawn see-through), as a bool array."""
@@ -292,8 +355,9 @@ class Renderer:
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDisable(GL.GL_BLEND)
 
-        if self.plane_vertices:  # front faces, opaque
+        if self.plane_vertices:  # front faces, opaque, with the balls' shadows
             self._common_uniforms(self.plane_program, view_projection, eye)
+            self._shadow_uniforms(self.plane_program)
             GL.glEnable(GL.GL_CULL_FACE)
             GL.glCullFace(GL.GL_BACK)
             GL.glBindVertexArray(self.plane_vao)
@@ -395,3 +459,5 @@ class Renderer:
         GL.glDeleteVertexArrays(
             5, [self.ball_vao, self.plane_vao, self.line_vao, self.ghost_vao, self.screen_vao]
         )
+        GL.glDeleteBuffers(2, list(self.shadow_buffers))
+        GL.glDeleteTextures(2, list(self.shadow_textures))

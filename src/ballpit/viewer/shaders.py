@@ -143,6 +143,14 @@ class Program:
             setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv, 4: GL.glUniform4fv}[arr.shape[-1]]
             setter(loc, 1, arr)
 
+    def set_int(self, uniform: str, value: int) -> None:
+        """Set an int uniform, such as the texture unit a sampler reads (the program must be in use)."""
+        from OpenGL import GL
+
+        loc = self.location(uniform)
+        if loc >= 0:
+            GL.glUniform1i(loc, int(value))
+
     def delete(self) -> None:
         from OpenGL import GL
 

@@ -1,0 +1,188 @@
+"""Ball shadows and contact darkening on the planes: real shaders, real pixels read back, each picture
+compared with the same view of the floor without the ball."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.viewer import shadows
+from ballpit.viewer.camera import Camera
+from ballpit.viewer.simulation import Simulation
+
+from .test_renderer import sphere_mask
+
+SUN = shadows.SUN_DIRECTION
+# looking down at the floor from the side away from the sun, so shadows fall towards the camera
+CAMERA = Camera.looking_at((-2.5, 6.0, -4.0), (-0.6, 0.0, -0.8))
+
+
+def floor_scene(balls: list[tuple[tuple[float, float, float], float]]) -> Simulation:
+    """An infinite floor and the given (centre, radius) balls, standing still."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    for center, radius in balls:
+        world.add_sphere(position=center, radius=radius)
+    return Simulation(world)
+
+
+def brightness(image: np.ndarray) -> np.ndarray:
+    return image.astype(float).sum(axis=-1)
+
+
+def pixel(point) -> tuple[int, int]:
+    (x, y), _ = CAMERA.project(np.asarray(point, float), 200, 150)
+    return int(y), int(x)
+
+
+def darkening(offscreen, balls) -> tuple[np.ndarray, np.ndarray]:
+    """How much darker each floor pixel is with the balls than without (brightness, 0..765), and
+    which pixels the balls themselves cover (excluded from any comparison)."""
+    empty = brightness(offscreen.render(floor_scene([]), CAMERA))
+    shaded = brightness(offscreen.render(floor_scene(balls), CAMERA))
+    covered = np.zeros(empty.shape, dtype=bool)
+    for center, radius in balls:
+        covered |= sphere_mask(CAMERA, center, radius * 1.08)  # a margin for the anti-aliased rim
+    return np.where(covered, 0.0, empty - shaded), covered
+
+
+def shadow_center(center, height: float = 0.0) -> np.ndarray:
+    """Where the ray from a ball's centre away from the sun meets the floor."""
+    center = np.asarray(center, float)
+    return center - SUN * (center[1] - height) / SUN[1]
+
+
+def test_the_floor_under_a_resting_ball_is_darker_than_far_from_it(offscreen):
+    ball = ((0.0, 0.4, 0.0), 0.4)
+    dark, covered = darkening(offscreen, [ball])
+    # in its shadow, just outside its silhouette on the side away from the sun
+    shade_point = shadow_center(ball[0]) - SUN * np.array([1, 0, 1]) * 0.3
+    assert not covered[pixel(shade_point)]
+    assert dark[pixel(shade_point)] > 120
+    # contact darkening beside where it touches, across the sun's direction: no shadow there, yet darker
+    across = np.cross(SUN, [0.0, 1.0, 0.0])
+    beside = 0.45 * across / np.linalg.norm(across)
+    assert not covered[pixel(beside)]
+    assert dark[pixel(beside)] > 10
+    # far from the ball the floor is exactly as it was
+    for far in ([2.0, 0.0, 1.5], [-3.0, 0.0, 0.5], [1.0, 0.0, -3.0]):
+        assert abs(dark[pixel(far)]) <= 3
+    # and a ball resting on the floor is all it takes: the floor is still drawn in one draw call
+    labels = [c.label for c in offscreen.renderer.draws.calls]
+    assert labels.count("planes") == 1 and labels.count("balls") == 1
+
+
+def shadow_centroid(dark: np.ndarray, threshold: float = 60.0) -> np.ndarray:
+    rows, cols = np.nonzero(dark > threshold)
+    assert len(rows) > 30
+    return np.array([cols.mean() + 0.5, rows.mean() + 0.5])
+
+
+def test_a_ball_far_above_casts_its_shadow_offset_along_the_light(offscreen):
+    ball = ((0.0, 2.0, 0.0), 0.35)
+    dark, covered = darkening(offscreen, [ball])
+    expected = shadow_center(ball[0])
+    (ex, ey), _ = CAMERA.project(expected, 200, 150)
+    assert shadow_centroid(dark) == pytest.approx([ex, ey], abs=2.0)
+    # offset along the light, away from the sun: nothing right under the ball
+    below = pixel((0.0, 0.0, 0.0))
+    assert not covered[below] and abs(dark[below]) <= 3
+    assert np.linalg.norm(expected) > 1.2  # 2 m up: 1.25 m aside
+
+
+def test_the_shadow_moves_when_the_ball_moves(offscreen):
+    first = ((0.0, 1.0, 0.0), 0.35)
+    moved = ((-1.0, 1.0, 0.5), 0.35)
+    centroids = []
+    for ball in (first, moved):
+        dark, _ = darkening(offscreen, [ball])
+        centroids.append(shadow_centroid(dark))
+    for ball, centroid in zip((first, moved), centroids, strict=True):
+        (ex, ey), _ = CAMERA.project(shadow_center(ball[0]), 200, 150)
+        assert centroid == pytest.approx([ex, ey], abs=2.0)
+    assert np.linalg.norm(centroids[1] - centroids[0]) > 10  # pixels
+
+
+def test_the_shadow_moves_with_a_falling_ball_in_the_running_viewer(offscreen):
+    """Driven by the physics: as a ball falls, its shadow closes in on the point under it."""
+    world = ballpit.World()
+    world.add_plane(position=(0, 0, 0))
+    world.add_sphere(position=(0.0, 2.0, 0.0), radius=0.35)
+    sim = Simulation(world)
+    empty = brightness(offscreen.render(floor_scene([]), CAMERA))
+    sim.start()
+    centroids = []
+    for _ in range(2):
+        height = float(sim.world.spheres[0].position[1])
+        dark = empty - brightness(offscreen.render(sim, CAMERA))
+        dark[sphere_mask(CAMERA, sim.world.spheres[0].position, 0.35 * 1.08)] = 0.0
+        (ex, ey), _ = CAMERA.project(shadow_center((0.0, height, 0.0)), 200, 150)
+        centroids.append(shadow_centroid(dark))
+        assert centroids[-1] == pytest.approx([ex, ey], abs=2.5)
+        for _ in range(24):  # 0.4 s: it falls about 0.8 m
+            sim.advance(1 / 60)
+    assert np.linalg.norm(centroids[1] - centroids[0]) > 8
+
+
+def test_shadows_fall_on_slopes_too_and_can_be_turned_off(offscreen):
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 1.0, 0), rotation=(0, 0, 15), size=3.0)
+    world.add_sphere(position=(0.0, 2.2, 0.0), radius=0.3)
+    sim = Simulation(world)
+    slope_point = shadow_center((0.0, 2.2, 0.0), height=1.0)  # roughly: the slope is gentle
+    with_shadows = brightness(offscreen.render(sim, CAMERA))
+    offscreen.renderer.shadows = False
+    try:
+        without = brightness(offscreen.render(sim, CAMERA))
+    finally:
+        offscreen.renderer.shadows = True
+    assert (without - with_shadows)[pixel(slope_point)] > 100
+
+
+# ---------------------------------------------------------------- the grid itself (no GL)
+
+
+def cells_read(grid: shadows.ShadowGrid, point: np.ndarray) -> range:
+    """Which balls (rows of grid.balls) the plane shader reads for a point, as plane.frag does."""
+    g = (grid.axes @ point - grid.origin) / grid.cell_size
+    nx, ny = grid.shape
+    if not (0 <= g[0] < nx and 0 <= g[1] < ny):
+        return range(0)
+    first, end = grid.ranges[int(g[1]) * nx + int(g[0])]
+    return range(first, end)
+
+
+def test_every_ball_within_reach_of_a_point_is_in_the_cells_the_shader_reads():
+    rng = np.random.default_rng(3)
+    centers = rng.uniform((-3, 0.1, -3), (3, 4, 3), size=(400, 3))
+    radii = rng.uniform(0.05, 0.3, size=400)
+    grid = shadows.build(centers, radii, limit=10_000)
+    assert grid.dropped == 0 and len(grid.balls) >= 400
+    axes = shadows.sun_basis()
+    for point in rng.uniform((-4, -0.5, -4), (4, 4, 4), size=(300, 3)):
+        across = np.linalg.norm((centers - point) @ axes.T, axis=1)
+        near = np.flatnonzero(across <= shadows.REACH * radii)
+        read = grid.balls[sorted(cells_read(grid, point))]
+        for k in near:
+            assert np.any(np.all(np.isclose(read[:, :3], centers[k]), axis=1))
+
+
+def test_a_crowded_cell_keeps_the_balls_nearest_the_sun():
+    column = np.linspace(0.1, 3.0, 30)[:, None] * SUN  # 30 balls in a row along the sun's rays
+    grid = shadows.build(column[::-1], np.full(30, 0.05), limit=8)
+    read = grid.balls[list(cells_read(grid, column[0]))]  # what a point under the row reads
+    assert len(read) == 8 and grid.dropped > 0
+    along = read[:, :3] @ SUN
+    assert np.all(np.diff(along) < 0)  # nearest the sun first
+    assert along.min() == pytest.approx(np.sort(column @ SUN)[-8], rel=1e-6)
+
+
+def test_the_sun_grid_stays_bounded():
+    rng = np.random.default_rng(4)
+    centers = np.concatenate([rng.uniform(-500, 500, size=(1000, 3)), rng.uniform(-1, 1, size=(1000, 3))])
+    grid = shadows.build(centers, np.full(2000, 0.01))
+    assert grid.cells <= shadows.MAX_CELLS
+    assert grid.ranges.shape == (grid.cells, 2) and grid.ranges[-1, 1] == len(grid.balls)
+    assert np.all(np.diff(grid.ranges, axis=1) <= shadows.LIMIT)
+    assert np.all(grid.ranges[1:, 0] == grid.ranges[:-1, 1])
