@@ -7,9 +7,11 @@ never open a window here: they run real windows in subprocesses under an Xvfb se
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -86,6 +88,21 @@ def subprocess_env(display: str | None) -> dict[str, str]:
         env["DISPLAY"] = display
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO / "src"), env.get("PYTHONPATH")]))
     return env
+
+
+def run_driver(
+    driver: Path, display: str, name: str, workdir: Path, *extra: str, timeout: float = 300
+) -> dict:
+    """Run scenario ``name`` of a window driver script under ``display``; its ``RESULT <json>`` line."""
+    proc = subprocess.run(
+        [sys.executable, str(driver), name, str(workdir), *extra],
+        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=timeout,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
+    assert lines, proc.stdout + proc.stderr
+    return json.loads(lines[-1][len("RESULT ") :])
 
 
 def line_of_balls(n: int = 5, y: float = 6.0, gravity: tuple = (0.0, -9.81, 0.0)) -> ballpit.World:

@@ -3,28 +3,19 @@
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-from .conftest import REPO, subprocess_env
+from .conftest import REPO, run_driver, subprocess_env
 
 DRIVER = Path(__file__).with_name("history_driver.py")
 
 
 def run_scenario(display: str, name: str, workdir: Path, *extra: str) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(DRIVER), name, str(workdir), *extra],
-        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
-    assert lines, proc.stdout + proc.stderr
-    return json.loads(lines[-1][len("RESULT ") :])
+    return run_driver(DRIVER, display, name, workdir, *extra, timeout=300)
 
 
 def test_arrow_keys_and_a_dragged_timeline_move_through_the_history_exactly(xvfb, tmp_path):

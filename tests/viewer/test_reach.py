@@ -3,7 +3,6 @@ Physics outcomes are checked against closed forms."""
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 import subprocess
@@ -16,22 +15,14 @@ import pytest
 import ballpit
 from ballpit.viewer.interaction import LIFT_SPEED, THROW_WINDOW, TILT_RATE
 
-from .conftest import subprocess_env
+from .conftest import run_driver, subprocess_env
 
 DRIVER = Path(__file__).with_name("reach_driver.py")
 needs_xdotool = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(DRIVER), name, str(workdir)],
-        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=180,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
-    assert lines, proc.stdout + proc.stderr
-    return json.loads(lines[-1][len("RESULT ") :])
+    return run_driver(DRIVER, display, name, workdir, timeout=180)
 
 
 def drag_velocity(r: dict) -> np.ndarray:

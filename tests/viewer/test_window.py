@@ -3,7 +3,6 @@ either a window process or a headless one, and this pytest process renders headl
 
 from __future__ import annotations
 
-import json
 import re
 import shutil
 import subprocess
@@ -14,22 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from .conftest import REPO, subprocess_env
+from .conftest import REPO, run_driver, subprocess_env
 from .window_driver import GOOD_SCENE
 
 DRIVER = Path(__file__).with_name("window_driver.py")
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(DRIVER), name, str(workdir)],
-        env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
-    assert lines, proc.stdout + proc.stderr
-    return json.loads(lines[-1][len("RESULT ") :])
+    return run_driver(DRIVER, display, name, workdir, timeout=120)
 
 
 def test_the_title_shows_the_frame_rate(xvfb, tmp_path):
