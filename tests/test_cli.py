@@ -210,23 +210,23 @@ def test_bundled_scene_by_name_from_anywhere(tmp_path):
 def test_simulate_writes_csv_with_exact_columns_and_a_summary(tmp_path):
     out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
     r = ballpit(
-        "simulate", "scenes/slopes.toml", "--duration", "0.7", "--every", "4", "--out", out, "--events", ev
+        "simulate", "scenes/slopes.toml", "--duration", "0.9", "--every", "4", "--out", out, "--events", ev
     )
     assert r.returncode == 0, r.stderr
-    for fragment in ("168 steps", "steps/s", "wall time", "contacts", "energy start", "kinetic", "potential"):
+    for fragment in ("216 steps", "steps/s", "wall time", "contacts", "energy start", "kinetic", "potential"):
         assert fragment in r.stdout
     assert "Traceback" not in r.stderr
 
     lines = out.read_text().splitlines()
     assert lines[0] == TRAJECTORY_HEADER
     data = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert data.shape == (5 * (168 // 4 + 1), 15)
-    assert np.array_equal(data[:, 1], np.tile(np.arange(5), 168 // 4 + 1))
+    assert data.shape == (5 * (216 // 4 + 1), 15)
+    assert np.array_equal(data[:, 1], np.tile(np.arange(5), 216 // 4 + 1))
     times = data[::5, 0]
     assert (
         times[0] == 0.0
         and np.allclose(np.diff(times), 4 / 240, atol=1e-6)
-        and times[-1] == pytest.approx(0.7)
+        and times[-1] == pytest.approx(0.9)
     )
     start = load_scene(ROOT / "scenes" / "slopes.toml").spheres.positions
     assert np.allclose(data[:5, 2:5], start)  # the first record: where the scene file puts the balls
@@ -238,9 +238,9 @@ def test_simulate_writes_csv_with_exact_columns_and_a_summary(tmp_path):
     assert rows and all(len(row) == 11 for row in rows)
     assert {row[1] for row in rows} <= {"sphere-plane", "sphere-sphere"}
     assert {int(row[3]) for row in rows if row[1] == "sphere-plane"} >= {1, 2, 3, 4}, (
-        "by 0.7 s every slope is hit"
+        "by 0.9 s every slope is hit"
     )
-    assert all(0 < float(row[0]) <= 0.7 + 1e-9 and float(row[10]) >= 0 for row in rows)
+    assert all(0 < float(row[0]) <= 0.9 + 1e-9 and float(row[10]) >= 0 for row in rows)
     assert sorted(tmp_path.iterdir()) == sorted([ev, out]), "no temporary files left"
 
 
