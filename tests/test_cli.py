@@ -283,34 +283,27 @@ def test_duration_that_is_not_a_whole_number_of_steps_ends_exactly(tmp_path):
     assert times[-1] == pytest.approx(0.105) and len(times) == 12
 
 
-def test_interrupt_leaves_no_partial_file(tmp_path):
-    out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
+def interrupt_while_writing(args: list, folder: Path) -> tuple[int, str]:
+    """Run ``ballpit ARGS`` from the repository and press Ctrl+C once it is writing into ``folder`` (a
+    ``.partial`` file there) and half a second into its steps; its exit status and stderr."""
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "ballpit",
-            "simulate",
-            "scenes/pile10k.toml",
-            "--duration",
-            "60",
-            "--out",
-            out,
-            "--events",
-            ev,
-        ],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+        [sys.executable, "-m", "ballpit", *map(str, args)], cwd=ROOT,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
     deadline = time.monotonic() + 60
-    while not any(p.name.endswith(".partial") for p in tmp_path.iterdir()) and time.monotonic() < deadline:
+    while not any(p.name.endswith(".partial") for p in folder.iterdir()) and time.monotonic() < deadline:
         time.sleep(0.05)
     time.sleep(0.5)  # now inside the stepping loop
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 130, stderr
+    return proc.returncode, stderr
+
+
+def test_interrupt_leaves_no_partial_file(tmp_path):
+    out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
+    args = ["simulate", "scenes/pile10k.toml", "--duration", "60", "--out", out, "--events", ev]
+    status, stderr = interrupt_while_writing(args, tmp_path)
+    assert status == 130, stderr
     assert "interrupted" in stderr and "Traceback" not in stderr
     assert list(tmp_path.iterdir()) == []
 

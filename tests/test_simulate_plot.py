@@ -3,10 +3,8 @@ an Euler ball's fall, see bouncing_box.py) and the PNG written complete or not a
 
 from __future__ import annotations
 
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +16,7 @@ from ballpit.scene import load_scene
 from ballpit.simulate import run
 
 from .bouncing_box import DT, E0, MASS, V0, Y0, G, euler_gain_per_step_law, write_scene
+from .test_cli import interrupt_while_writing
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -94,19 +93,7 @@ def test_bad_plot_path_is_one_line_and_nothing_runs(tmp_path, plot, fragment):
 def test_interrupted_run_leaves_no_plot(tmp_path):
     scene = write_scene(tmp_path, dt=1e-4)
     png = tmp_path / "energy.png"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "ballpit", "simulate", str(scene), "--duration", "60", "--plot", str(png)],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    deadline = time.monotonic() + 60
-    while not any(p.name.endswith(".partial") for p in tmp_path.iterdir()) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.5)  # now inside the stepping loop
-    proc.send_signal(signal.SIGINT)
-    _, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 130, stderr
+    status, stderr = interrupt_while_writing(["simulate", scene, "--duration", "60", "--plot", png], tmp_path)
+    assert status == 130, stderr
     assert "Traceback" not in stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["box.toml"]
