@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .physics import INTEGRATOR_NAMES
 
 if TYPE_CHECKING:
     from .physics import World
@@ -115,6 +116,16 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _add_run_arguments(p: argparse.ArgumentParser) -> None:
+    """The scene, --duration and --dt that simulate and compare share."""
+    p.add_argument("scene", help="a scene file, or a bundled scene's name")
+    p.add_argument("--duration", type=_positive, metavar="S", help="seconds to simulate (default: the "
+                   "scene's [world] duration, else 10)")  # fmt: skip
+    p.add_argument(
+        "--dt", type=_positive, metavar="S", help="seconds per step (default: the scene's timestep)"
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
     parser = OneLineParser(
@@ -148,13 +159,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run a scene without a window. The trajectory has one row per ball per recorded step "
         "(the initial state, every K-th step and the final state); events one row per contact.",
     )
-    p.add_argument("scene", help="a scene file, or a bundled scene's name")
-    p.add_argument("--duration", type=_positive, metavar="S", help="seconds to simulate (default: the "
-                   "scene's [world] duration, else 10)")  # fmt: skip
-    p.add_argument(
-        "--dt", type=_positive, metavar="S", help="seconds per step (default: the scene's timestep)"
-    )
-    p.add_argument("--integrator", choices=("euler", "rk2", "rk4"), help="override the scene's integrator")
+    _add_run_arguments(p)
+    p.add_argument("--integrator", choices=INTEGRATOR_NAMES, help="override the scene's integrator")
     p.add_argument("--out", type=Path, metavar="FILE", help="trajectory file, .csv or .npz")
     p.add_argument("--events", type=Path, metavar="FILE", help="contact events file, .csv or .npz")
     p.add_argument(
@@ -179,12 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
         "quarter of the step as a reference; print each one's total-energy drift and how far its balls "
         "end from the reference's.",
     )
-    p.add_argument("scene", help="a scene file, or a bundled scene's name")
-    p.add_argument("--duration", type=_positive, metavar="S", help="seconds to simulate (default: the "
-                   "scene's [world] duration, else 10)")  # fmt: skip
-    p.add_argument(
-        "--dt", type=_positive, metavar="S", help="seconds per step (default: the scene's timestep)"
-    )
+    _add_run_arguments(p)
     p.add_argument("--plot", type=Path, metavar="FILE", help="plot each integrator's total-energy drift "
                    "over time: .png, .svg or .pdf")  # fmt: skip
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")

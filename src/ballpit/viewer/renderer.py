@@ -80,6 +80,16 @@ def _offset(floats: int) -> ctypes.c_void_p:
     return ctypes.c_void_p(floats * _FLOAT)
 
 
+def _vertex_array() -> tuple[int, int]:
+    """A vertex array and its buffer of (x, y, z, r, g, b, a) vertices, left bound."""
+    vao, vbo = GL.glGenVertexArrays(1), GL.glGenBuffers(1)
+    GL.glBindVertexArray(vao)
+    GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vbo)
+    _attribute(0, 3, VERTEX_WIDTH, 0)
+    _attribute(1, 4, VERTEX_WIDTH, 3)
+    return vao, vbo
+
+
 def _attribute(index: int, size: int, stride_floats: int, offset_floats: int, divisor: int = 0) -> None:
     GL.glEnableVertexAttribArray(index)
     GL.glVertexAttribPointer(
@@ -166,22 +176,12 @@ class Renderer:
         GL.glUseProgram(0)
 
         # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
-        self.line_vao = GL.glGenVertexArrays(1)
-        self.line_vbo = GL.glGenBuffers(1)
-        GL.glBindVertexArray(self.line_vao)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.line_vbo)
-        _attribute(0, 3, VERTEX_WIDTH, 0)
-        _attribute(1, 4, VERTEX_WIDTH, 3)
+        self.line_vao, self.line_vbo = _vertex_array()
         self.world_line_vertices = 0
         self.overlay_line_vertices = 0
 
         # screen-space overlays in window pixels (timeline bar, energy plot): triangles, then lines
-        self.screen_vao = GL.glGenVertexArrays(1)
-        self.screen_vbo = GL.glGenBuffers(1)
-        GL.glBindVertexArray(self.screen_vao)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.screen_vbo)
-        _attribute(0, 3, VERTEX_WIDTH, 0)
-        _attribute(1, 4, VERTEX_WIDTH, 3)
+        self.screen_vao, self.screen_vbo = _vertex_array()
         self.screen_triangle_vertices = 0
         self.screen_line_vertices = 0
         self.screen_size = (1.0, 1.0)

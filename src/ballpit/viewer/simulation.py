@@ -403,29 +403,26 @@ class Simulation:
         spheres = self.world.spheres
         pos = np.asarray(spheres.positions, dtype=float)
         quat = np.asarray(spheres.orientations, dtype=float)
-        a = self.alpha
-        if a >= 1.0 or self.phase is not Phase.RUNNING:
-            return pos, quat
-        positions = self.prev_positions + (pos - self.prev_positions) * a
-        prev_q = self.prev_orientations
-        sign = np.where(np.einsum("ij,ij->i", prev_q, quat) < 0.0, -1.0, 1.0)[:, None]
-        q = prev_q * (1.0 - a) + quat * sign * a
-        q /= np.linalg.norm(q, axis=1, keepdims=True)
-        return positions, q
+        return self._interpolated(self.prev_positions, pos, self.prev_orientations, quat)
 
     def render_planes(self) -> tuple[np.ndarray, np.ndarray]:
         """Plane centres (P, 3) and orientations (P, 4) at the same ``alpha`` as ``render_state``."""
         planes = self.world.planes
         pos = np.asarray(planes.centers, dtype=float)
         quat = np.asarray(planes.orientations, dtype=float)
+        return self._interpolated(self.prev_plane_centers, pos, self.prev_plane_orientations, quat)
+
+    def _interpolated(self, prev_pos: np.ndarray, pos: np.ndarray, prev_q: np.ndarray,
+                      quat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """``alpha`` of the way from the previous step's poses to these: positions lerped, quaternions
+        nlerped along the short arc (the current poses themselves once the step is reached or paused)."""
         a = self.alpha
         if a >= 1.0 or self.phase is not Phase.RUNNING:
             return pos, quat
-        prev_q = self.prev_plane_orientations
         sign = np.where(np.einsum("ij,ij->i", prev_q, quat) < 0.0, -1.0, 1.0)[:, None]
         q = prev_q * (1.0 - a) + quat * sign * a
         q /= np.linalg.norm(q, axis=1, keepdims=True)
-        return self.prev_plane_centers + (pos - self.prev_plane_centers) * a, q
+        return prev_pos + (pos - prev_pos) * a, q
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy of all balls, J (the physics' own measure)."""
