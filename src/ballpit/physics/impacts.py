@@ -54,7 +54,7 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
         involved[c.b[near]] = True
         involved[n] = False
         near = involved[c.a] | involved[c.b]
-    island = rows.subset(near, n)
+    island = rows.subset(near)
     target = np.where(arriving[near], -island.restitution * vn[near], -allowance[near])
     imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations)
     body = state.body

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import jacobi, solver
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
@@ -28,6 +29,18 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         return
     x = state.body[:, X]
     pos = with_static(x)
+    if len(c) >= solver.JACOBI_FROM:  # all contacts at once per sweep, with mass splitting
+        sweeps = solver.JACOBI_SWEEPS * SWEEPS
+        jacobi.separate(c.a, c.b, c.normal, c.gap, rows.inv_mass_a, rows.inv_mass_b, pos, sweeps)
+    else:
+        _separate_by_colour(c, rows, pos)
+    new = keep_sides_of_planes(model, state, x, pos[:-1])
+    pay_for_lift(model, state, x, new)
+    x[:] = new
+
+
+def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) -> None:
+    """Gauss–Seidel sweeps over the contact colours; ``pos`` (N+1, 3) changes in place."""
     n = c.normal
     offset = np.einsum("ij,ij->i", n, pos[c.a] - pos[c.b]) - c.gap
     share = rows.inv_mass_a / (rows.inv_mass_a + rows.inv_mass_b)
@@ -39,9 +52,6 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
             pos[a] += depth * share[idx, None]
             pos[b] -= depth * (1.0 - share[idx, None])
         pos[-1] = 0.0
-    new = keep_sides_of_planes(model, state, x, pos[:-1])
-    pay_for_lift(model, state, x, new)
-    x[:] = new
 
 
 def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray) -> None:

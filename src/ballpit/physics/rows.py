@@ -9,6 +9,7 @@ Material mixing (design.md): restitution e = e_a·e_b, friction μ = sqrt(μ_a·
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -37,7 +38,7 @@ class ContactRows:
     surface: np.ndarray  # (K, 3) velocity of b's surface at the contact beyond b's own (moving planes)
     spin: np.ndarray  # (K, 3) angular velocity of that surface (a turning plane's ω)
     moving: bool  # whether any contact has a moving surface (else surface and spin are zero)
-    colours: list[np.ndarray]
+    static: int  # the static world's row (the number of balls)
 
     def __len__(self) -> int:
         return len(self.a)
@@ -47,10 +48,16 @@ class ContactRows:
         a, b = self.arm_a[idx], self.arm_b[idx]
         return np.sqrt(np.einsum("ij,ij->i", a, a)), np.sqrt(np.einsum("ij,ij->i", b, b))
 
-    def subset(self, mask: np.ndarray, static: int) -> ContactRows:
-        """The contacts where ``mask`` holds, coloured afresh."""
-        fields = {k: v[mask] for k, v in vars(self).items() if k not in ("colours", "moving")}
-        return ContactRows(**fields, moving=self.moving, colours=colour(fields["a"], fields["b"], static))
+    @cached_property
+    def colours(self) -> list[np.ndarray]:
+        """Groups of contacts sharing no ball, for the colour-by-colour sweeps (found when first asked)."""
+        return colour(self.a, self.b, self.static)
+
+    def subset(self, mask: np.ndarray) -> ContactRows:
+        """The contacts where ``mask`` holds."""
+        kept = ("moving", "static")
+        fields = {k: v[mask] for k, v in vars(self).items() if k not in (*kept, "colours")}
+        return ContactRows(**fields, moving=self.moving, static=self.static)
 
 
 def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
@@ -91,7 +98,7 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
         surface=surface,
         spin=spin,
         moving=moving,
-        colours=colour(c.a, c.b, sph.count),
+        static=sph.count,
     )
 
 

@@ -20,42 +20,18 @@ mass, so a sphere–plane contact is a sphere–sphere contact whose second body
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from . import jacobi
+from .impulses import CONVERGED, Impulses, cap, skew
 from .rows import ContactRows
 
-# A sweep that changes no contact velocity by more than this (m/s) ends the iterations early.
-CONVERGED = 1e-9
-
-
-@dataclass
-class Impulses:
-    """Accumulated impulses per contact: normal (K,), friction (K, 3), rolling (K, 3)."""
-
-    normal: np.ndarray
-    friction: np.ndarray
-    rolling: np.ndarray
-
-    @staticmethod
-    def zeros(count: int) -> Impulses:
-        return Impulses(np.zeros(count), np.zeros((count, 3)), np.zeros((count, 3)))
-
-
-def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
-    """Scale each row down to length ≤ limit (the friction cone and the rolling-resistance limit)."""
-    length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors) + 1e-300)  # + tiny: no 0/0 at zero
-    return vectors * np.minimum(limit / length, 1.0)[:, None]
-
-
-def skew(n: np.ndarray) -> np.ndarray:
-    """Matrices [n]× with [n]×·s = n × s, so a batch of cross products is one einsum."""
-    k = np.zeros((len(n), 3, 3))
-    k[:, 0, 1], k[:, 0, 2] = -n[:, 2], n[:, 1]
-    k[:, 1, 0], k[:, 1, 2] = n[:, 2], -n[:, 0]
-    k[:, 2, 0], k[:, 2, 1] = -n[:, 1], n[:, 0]
-    return k
+# From this many contacts on, a solve updates all of them at once (``jacobi.py``): per sweep it costs a
+# fixed number of NumPy calls instead of a few dozen per colour.
+JACOBI_FROM = 64
+# A Jacobi sweep carries a push one contact further, as a Gauss–Seidel sweep does along its colour
+# order at best; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for.
+JACOBI_SWEEPS = 2
 
 
 class _Colour:
@@ -133,6 +109,8 @@ def solve(
     rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates."""
     if len(contacts) == 0:
         return imp
+    if len(contacts) >= JACOBI_FROM:
+        return jacobi.solve(contacts, v, w, target, imp, JACOBI_SWEEPS * iterations)
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
     balls, local = np.unique(np.concatenate((contacts.a, contacts.b)), return_inverse=True)
@@ -165,7 +143,7 @@ def solve(
                 # friction: cancel slip (the tangential part of rel, which the normal impulse leaves
                 # alone), inside the Coulomb cone |P_t| ≤ μ·P_n
                 old_t = friction[k]
-                new_t = _cap(old_t - c.m_t * (rel - vn[:, None] * c.n), c.mu * new)
+                new_t = cap(old_t - c.m_t * (rel - vn[:, None] * c.n), c.mu * new)
                 friction[k] = new_t
                 d_t = new_t - old_t
                 linear += d_t
@@ -177,7 +155,7 @@ def solve(
                 # rolling resistance: oppose relative spin (after the friction turn), up to ρ·r·P_n
                 old_r = rolling[k]
                 spin = wa - wb - c.spin if c.moving else wa - wb
-                new_r = _cap(old_r - c.m_r * spin, c.rolling * new)
+                new_r = cap(old_r - c.m_r * spin, c.rolling * new)
                 rolling[k] = new_r
                 g[:, :, 3:] += c.roll * (new_r - old_r)
 

@@ -27,6 +27,9 @@ from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache
 from .profile import StepProfile
 from .state import State, V, W, with_static
 
+# Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
+# meeting makes the step crowded (a pile, not a textbook scene).
+CROWD_PAIRS = 256
 # The pairs of a crowded step are those within this many times the distance they could close.
 SPECULATIVE_REACH = 2.0
 # In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
@@ -73,7 +76,9 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> Contact
     dt, model = step.dt, step.model
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
-    if np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP)) <= model.crowd_limit:
+    meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
+    limit = model.crowd_limit if len(c) < CROWD_PAIRS else 0
+    if meetings <= limit:
         return None
     return c.subset(speculative_reach(step, c, accel, dv, da))
 
