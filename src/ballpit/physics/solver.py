@@ -31,7 +31,7 @@ from .rows import ContactRows
 JACOBI_FROM = 64
 # A Jacobi sweep carries a push one contact further, as a Gauss–Seidel sweep does along its colour
 # order at best; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for.
-JACOBI_SWEEPS = 2
+JACOBI_SWEEPS = 1
 
 
 class _Colour:

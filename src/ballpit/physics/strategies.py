@@ -65,8 +65,9 @@ class Step:
         self.profile.intervals += 1
 
 
-def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> ContactPoints | None:
-    """The contacts of a crowded step, or None when few enough pairs meet to split the step.
+def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray | None:
+    """Which of the contacts ``c`` a crowded step solves (a mask), or None when few enough pairs meet
+    to split the step.
 
     Meetings are counted along today's normals: the gap after dt, g + v_n·dt + ½·a_n·dt², falls to
     contact. More than ``model.crowd_limit`` meetings make the step crowded. Its contacts are every
@@ -77,10 +78,10 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> Contact
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
-    limit = model.crowd_limit if len(c) < CROWD_PAIRS else 0
-    if meetings <= limit:
+    many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
+    if meetings <= (0 if many else model.crowd_limit):
         return None
-    return c.subset(speculative_reach(step, c, accel, dv, da))
+    return speculative_reach(step, c, accel, dv, da)
 
 
 def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray, dv: np.ndarray | None = None,
@@ -177,9 +178,9 @@ def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPer
 
 
 def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
-                                    c: ContactPoints) -> None:  # fmt: skip
-    """The whole step as one interval, with speculative contacts ``c`` (from ``crowded_contacts``);
-    ``contacts`` are all the kept ``pairs`` measured now.
+                                    solved: np.ndarray) -> None:  # fmt: skip
+    """The whole step as one interval, with speculative contacts: those of ``contacts`` (all the kept
+    ``pairs`` measured now) where ``solved`` holds (from ``crowded_contacts``).
 
     A contact with a gap may close by at most that gap, v_n ≥ −gap/dt, and the constraint only pushes
     if the pair would otherwise pass it. A pair arriving faster than the bounce threshold leaves at e
@@ -194,6 +195,7 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
     shallower overlaps are removed at the next step's start.
     """
     model, state, prof, dt, now = step.model, step.state, step.profile, step.dt, step.state.time
+    c = contacts.subset(solved)
     allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)  # how fast each may close (m/s)
     with prof.stage("contact rows"):
         batch = rows.contact_rows(model, state, c)
@@ -206,9 +208,9 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
     # The bounces turned some balls towards neighbours they were not closing on before: those pairs
     # join the speculative contacts, and bounce in turn if they now arrive.
     with prof.stage("crowd test"):
-        reach = speculative_reach(step, contacts, free)
-        joined = reach & ~np.isin(contacts.keys(), c.keys())
+        joined = speculative_reach(step, contacts, free) & ~solved
     if joined.any():
+        solved = solved | joined
         c = ContactPoints.concatenate([c, contacts.subset(joined)])
         allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
         with prof.stage("contact rows"):
@@ -224,8 +226,11 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
     with prof.stage("pairs"):
         if pairs.escaped(model, state, lin, dt):
             pairs = step.pairs.renew(model, state, dt, BROAD_PHASE_STEPS * dt, lin, free)
-        contacts = narrowphase.contact_points(model, state, pairs)
-        unguarded = contacts.subset(~np.isin(contacts.keys(), c.keys()))
+            contacts = narrowphase.contact_points(model, state, pairs)
+            solved = np.isin(contacts.keys(), c.keys())
+        else:  # the same pairs, where penetration removal left them
+            contacts = narrowphase.contact_points(model, state, pairs)
+        unguarded = contacts.subset(~solved)
     with prof.stage("time of impact"):
         deep = toi.deep_overlaps(model, state, unguarded, lin, dt, UNGUARDED_OVERLAP)
         h = toi.next_impact(model, state, unguarded.subset(deep), lin, dt) if deep.any() else np.inf
