@@ -19,18 +19,22 @@ from .state import State, V, W, with_static
 
 # The bounce is solved over the contacts within this many balls of an arriving one.
 BOUNCE_HOPS = 3
+# A bounce is solved afresh (no warm start, nothing to hold at rest): Jacobi sweeps per iteration.
+BOUNCE_JACOBI_SWEEPS = 1
 # Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
 APPROACH_SPEED = 1e-6
 
 
 def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
-           allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool) -> None:  # fmt: skip
+           allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
+           seeds_among: np.ndarray | None = None) -> None:  # fmt: skip
     """Bounce the contacts that arrive, with their island; velocities change in place.
 
     ``allowance`` (m/s) is how fast each contact may close without being stopped: zero for a
     touching contact, gap/dt for a speculative one, which therefore arrives only faster than that and
     otherwise keeps closing at that speed. With ``arrivals_only`` only arrivals faster than the
     threshold start an island; otherwise any approach does (and the slow ones in it just stop).
+    ``seeds_among``, when given, is where islands may start (other contacts only join them).
     """
     if len(c) == 0:
         return
@@ -43,6 +47,8 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
     approaching = vn < -(allowance + APPROACH_SPEED)
     arriving = approaching & (-vn > threshold)
     seeds = arriving if arrivals_only else approaching
+    if seeds_among is not None:
+        seeds = seeds & seeds_among
     if not seeds.any():
         return
     # The island around the impacts: contacts within BOUNCE_HOPS balls of a seed.
@@ -56,7 +62,8 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
         near = involved[c.a] | involved[c.b]
     island = rows.subset(near)
     target = np.where(arriving[near], -island.restitution * vn[near], -allowance[near])
-    imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations)
+    imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations,
+                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS)  # fmt: skip
     body = state.body
     body[:, V] = v[:-1]
     body[:, W] = w[:-1]

@@ -55,6 +55,7 @@ class _Contacts:
         iia, iib = contacts.inv_inertia_a, contacts.inv_inertia_b
         self.ra, self.rb = contacts.arm_lengths()
         ra, rb = self.ra, self.rb
+        self.arms = np.concatenate((ra, rb))  # each end's lever arm ρ, in the order of ``ends``
         self.n = np.ascontiguousarray(contacts.normal.T)
         self.n_yzx, self.n_zxy = np.take(self.n, _YZX, axis=0), np.take(self.n, _ZXY, axis=0)
         # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts)
@@ -96,8 +97,9 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
         g = np.take(vw, c.ends, axis=1)
         va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
         # contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b)
+        arm_spin = g[3:] * c.arms
         rel = va - vb
-        rel += _cross(c.n_yzx, c.n_zxy, c.ra * wa + c.rb * wb)
+        rel += _cross(c.n_yzx, c.n_zxy, arm_spin[:, :k] + arm_spin[:, k:])
         if c.moving:  # relative to a moving plane's surface
             rel -= c.surface
         vn = np.einsum("ij,ij->j", rel, n)

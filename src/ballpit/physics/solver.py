@@ -29,9 +29,10 @@ from .rows import ContactRows
 # From this many contacts on, a solve updates all of them at once (``jacobi.py``): per sweep it costs a
 # fixed number of NumPy calls instead of a few dozen per colour.
 JACOBI_FROM = 64
-# A Jacobi sweep carries a push one contact further, as a Gauss–Seidel sweep does along its colour
-# order at best; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for.
-JACOBI_SWEEPS = 1
+# A Jacobi sweep with mass splitting moves each contact only part of the way a Gauss–Seidel update
+# would; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for (with one, a pile
+# of 200 balls kept jittering at 5 mm/s; with two it comes to rest below 1e-8 m/s).
+JACOBI_SWEEPS = 2
 
 
 class _Colour:
@@ -104,13 +105,15 @@ def solve(
     target: np.ndarray,
     imp: Impulses,
     iterations: int,
+    jacobi_sweeps: int = JACOBI_SWEEPS,
 ) -> Impulses:
     """Projected Gauss–Seidel: drive every contact's normal speed to ≥ ``target`` with friction and
-    rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates."""
+    rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates. From
+    JACOBI_FROM contacts on, ``jacobi_sweeps`` Jacobi sweeps stand for each iteration."""
     if len(contacts) == 0:
         return imp
     if len(contacts) >= JACOBI_FROM:
-        return jacobi.solve(contacts, v, w, target, imp, JACOBI_SWEEPS * iterations)
+        return jacobi.solve(contacts, v, w, target, imp, jacobi_sweeps * iterations)
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
     balls, local = np.unique(np.concatenate((contacts.a, contacts.b)), return_inverse=True)

@@ -211,13 +211,16 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
         joined = speculative_reach(step, contacts, free) & ~solved
     if joined.any():
         solved = solved | joined
+        new = np.r_[np.zeros(len(c), bool), np.ones(np.count_nonzero(joined), bool)]
         c = ContactPoints.concatenate([c, contacts.subset(joined)])
         allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
         with prof.stage("contact rows"):
             batch = rows.contact_rows(model, state, c)
+        # Only the joined pairs start islands: a contact the first pass bounced and that still closes
+        # is caught between neighbours bouncing too, and the resting solve stops it.
         with prof.stage("impacts"):
             impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
-                           arrivals_only=True)  # fmt: skip
+                           arrivals_only=True, seeds_among=new)  # fmt: skip
         free, ang = free_acceleration(state.body, step.forces)
     with prof.stage("resting solve"):
         push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, -allowance, step.warm,
