@@ -23,13 +23,14 @@ import numpy as np
 from .impulses import CONVERGED, Impulses
 from .rows import ContactRows
 
-# Rows of a vector (x, y, z) rotated to (y, z, x) and (z, x, y), for cross products by rows.
-_YZX, _ZXY = [1, 2, 0], [2, 0, 1]
 
-
-def _cross(n_yzx: np.ndarray, n_zxy: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """n × s for (3, K) arrays, with n's rows rotated ahead of time: n_y·s_z − n_z·s_y, …"""
-    return n_yzx * np.take(s, _ZXY, axis=0) - n_zxy * np.take(s, _YZX, axis=0)
+def _skew(n: np.ndarray) -> np.ndarray:
+    """(3, 3, K) matrices [n]× with [n]×·s = n × s, so a batch of cross products is one einsum."""
+    k = np.zeros((3, 3, n.shape[1]))
+    k[0, 1], k[0, 2] = -n[2], n[1]
+    k[1, 0], k[1, 2] = n[2], -n[0]
+    k[2, 0], k[2, 1] = -n[1], n[0]
+    return k
 
 
 class _Contacts:
@@ -39,6 +40,8 @@ class _Contacts:
     are the columns of each contact's a then b. A sweep gathers both ends with one ``np.take`` and adds
     every contact's impulse to its two balls with one ``np.bincount``. Laid out by component, every
     other operation is on contiguous rows of K numbers, without broadcasting over a short axis.
+    Friction and rolling resistance are solved as one (2, 3, K) block: the same update and the same
+    cap, with their own effective masses and limits (zero limits where a material has none).
     """
 
     def __init__(self, contacts: ContactRows) -> None:
@@ -53,15 +56,19 @@ class _Contacts:
         sa, sb = share[self.ends[:k]], share[self.ends[k:]]
         ima, imb = contacts.inv_mass_a, contacts.inv_mass_b
         iia, iib = contacts.inv_inertia_a, contacts.inv_inertia_b
-        self.ra, self.rb = contacts.arm_lengths()
-        ra, rb = self.ra, self.rb
+        ra, rb = contacts.arm_lengths()
+        self.minus_ra, self.minus_rb = -ra, -rb
         self.arms = np.concatenate((ra, rb))  # each end's lever arm ρ, in the order of ``ends``
         self.n = np.ascontiguousarray(contacts.normal.T)
-        self.n_yzx, self.n_zxy = np.take(self.n, _YZX, axis=0), np.take(self.n, _ZXY, axis=0)
-        # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts)
+        self.nx = _skew(self.n)
+        # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts):
+        # normal, then tangential (friction) and angular (rolling resistance) stacked as (2, 1, K)
         self.m_n = 1.0 / (sa * ima + sb * imb)
-        self.m_t = 1.0 / (sa * (ima + ra**2 * iia) + sb * (imb + rb**2 * iib))
-        self.m_r = 1.0 / np.maximum(sa * iia + sb * iib, 1e-300)
+        m_t = 1.0 / (sa * (ima + ra**2 * iia) + sb * (imb + rb**2 * iib))
+        m_r = 1.0 / np.maximum(sa * iia + sb * iib, 1e-300)
+        self.m_tr = np.stack((m_t, m_r))[:, None, :]
+        # the friction cone μ·P_n and the rolling limit ρ·r·P_n, per unit of normal impulse
+        self.limits = np.stack((contacts.friction, contacts.rolling))
         # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
         inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = ima, imb
@@ -70,13 +77,9 @@ class _Contacts:
         # bounds on how much a unit of impulse changes a contact's velocity, for the convergence test
         self.inv_m_n = float((ima + imb).max())
         self.inv_m_t = float((ima + ra**2 * iia + imb + rb**2 * iib).max())
-        self.mu = contacts.friction
-        self.rolling = contacts.rolling
         self.moving = contacts.moving
         self.surface = np.ascontiguousarray(contacts.surface.T)
         self.spin = np.ascontiguousarray(contacts.spin.T)
-        self.has_friction = bool(self.mu.any())
-        self.has_rolling = bool(self.rolling.any())
 
 
 def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarray, imp: Impulses,
@@ -86,20 +89,20 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     if len(contacts) == 0:
         return imp
     c = _Contacts(contacts)
-    k = c.k
+    k, n, nx = c.k, c.n, c.nx
     vw = np.ascontiguousarray(np.hstack((v[c.balls], w[c.balls])).T)  # (6, M)
     push = np.zeros((6, 2 * k))  # what each contact adds to its a (columns :k) and its b (columns k:)
     normal = imp.normal.copy()
-    friction = np.ascontiguousarray(imp.friction.T)
-    rolling = np.ascontiguousarray(imp.rolling.T)
-    n = c.n
+    # accumulated friction (row 0) and rolling-resistance (row 1) impulses
+    tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
+    motion = np.empty((2, 3, k))  # slip at the contact point, and relative spin
     for _ in range(iterations):
         g = np.take(vw, c.ends, axis=1)
         va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
         # contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b)
         arm_spin = g[3:] * c.arms
         rel = va - vb
-        rel += _cross(c.n_yzx, c.n_zxy, arm_spin[:, :k] + arm_spin[:, k:])
+        rel += np.einsum("ijk,jk->ik", nx, arm_spin[:, :k] + arm_spin[:, k:])
         if c.moving:  # relative to a moving plane's surface
             rel -= c.surface
         vn = np.einsum("ij,ij->j", rel, n)
@@ -110,26 +113,32 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
         normal = new
         linear = d_n * n
         change = float(np.abs(d_n).max()) * c.inv_m_n
-        if c.has_friction:
-            # friction: cancel slip inside the Coulomb cone |P_t| ≤ μ·P_n
-            new_t = _cap(friction - c.m_t * (rel - vn * n), c.mu * new)
-            d_t = new_t - friction
-            friction = new_t
-            linear += d_t
-            turn = _cross(c.n_yzx, c.n_zxy, d_t)  # n × ΔP_t
-            np.multiply(turn, -c.ra, out=push[3:, :k])
-            np.multiply(turn, -c.rb, out=push[3:, k:])
-            change = max(change, float(np.abs(d_t).max()) * c.inv_m_t)
-        else:
-            push[3:] = 0.0
-        if c.has_rolling:
-            # rolling resistance: oppose relative spin, up to ρ·r·P_n
-            spin = wa - wb - c.spin if c.moving else wa - wb
-            new_r = _cap(rolling - c.m_r * spin, c.rolling * new)
-            d_r = new_r - rolling
-            rolling = new_r
-            push[3:, :k] += d_r
-            push[3:, k:] -= d_r
+
+        # friction cancels slip inside the Coulomb cone |P_t| ≤ μ·P_n; rolling resistance opposes
+        # relative spin up to ρ·r·P_n
+        np.multiply(vn, n, out=motion[0])
+        np.subtract(rel, motion[0], out=motion[0])
+        np.subtract(wa, wb, out=motion[1])
+        if c.moving:
+            motion[1] -= c.spin
+        candidate = tangential - c.m_tr * motion
+        length = np.einsum("ijk,ijk->ik", candidate, candidate)
+        length += 1e-300  # no 0/0 at zero
+        np.sqrt(length, out=length)
+        scale = np.minimum(c.limits * new / length, 1.0)
+        new_tr = candidate * scale[:, None, :]
+        d_tr = new_tr - tangential
+        tangential = new_tr
+        d_t, d_r = d_tr[0], d_tr[1]
+        linear += d_t
+        turn = np.einsum("ijk,jk->ik", nx, d_t)  # n × ΔP_t
+        push_a, push_b = push[3:, :k], push[3:, k:]
+        np.multiply(turn, c.minus_ra, out=push_a)
+        push_a += d_r
+        np.multiply(turn, c.minus_rb, out=push_b)
+        push_b -= d_r
+        change = max(change, float(np.abs(d_t).max()) * c.inv_m_t)
+
         push[:3, :k] = linear
         np.negative(linear, out=push[:3, k:])
         total = np.bincount(c.scatter, weights=push.ravel(), minlength=6 * c.m).reshape(6, c.m)
@@ -141,14 +150,8 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     w[c.balls] = vw[3:].T
     v[-1] = 0.0
     w[-1] = 0.0
-    imp.normal[:], imp.friction[:], imp.rolling[:] = normal, friction.T, rolling.T
+    imp.normal[:], imp.friction[:], imp.rolling[:] = normal, tangential[0].T, tangential[1].T
     return imp
-
-
-def _cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
-    """Scale each column of (3, K) ``vectors`` down to length ≤ limit."""
-    length = np.sqrt(np.einsum("ij,ij->j", vectors, vectors) + 1e-300)  # + tiny: no 0/0 at zero
-    return vectors * np.minimum(limit / length, 1.0)
 
 
 def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, inv_mass_a: np.ndarray,
