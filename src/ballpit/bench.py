@@ -1,4 +1,5 @@
-"""Step-rate benchmarks: free flight, and a falling grid of balls piling into a box.
+"""Step-rate benchmarks: free flight, a falling grid of balls piling into a box, a pile at rest, and
+the slopes demo.
 
 Every measurement runs in its own process (``python -m ballpit.bench --one ...``) so engines and sizes
 do not share caches or memory, and so the peak resident memory per ball can be read honestly.
@@ -7,6 +8,7 @@ PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile 
     ballpit bench                       # free flight and pile tables at the default sizes
     ballpit bench --workload pile --sizes 1000,10000 --pybullet --plot scaling.png
     ballpit bench --workload settled --sizes 1000,10000,100000   # cost growth in a pile at rest
+    ballpit bench --workload slopes --steps 2400   # the slopes demo headless, 10 s of it
 """
 
 from __future__ import annotations
@@ -92,6 +94,10 @@ def _box_layout(workload: str, n: int) -> tuple[np.ndarray, float]:
 def _ballpit_world(workload: str, n: int):
     import ballpit
 
+    if workload == "slopes":  # the bundled demo as it is (its own ball count; ``n`` is not used)
+        from .scene import read_scene, resolve_scene_path
+
+        return read_scene(resolve_scene_path("slopes")).world
     world = ballpit.World(integrator="rk4")
     if workload == "free":
         rng = np.random.default_rng(0)
@@ -161,6 +167,8 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
         step()
     seconds = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+    if engine == "ballpit":
+        n = len(world.spheres)  # the slopes demo has its own
     return Result(engine, workload, n, steps, seconds, (peak - base) * 1024.0 / n)
 
 
@@ -247,9 +255,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = OneLineParser(prog="ballpit bench", description=__doc__.splitlines()[0])
     parser.add_argument(
         "--workload",
-        choices=("free", "pile", "settled", "all"),
+        choices=("free", "pile", "settled", "slopes", "all"),
         default="all",
-        help="free flight; a grid falling into a box (the pile forming); or a pile already at rest",
+        help="free flight; a grid falling into a box (the pile forming); a pile already at rest; or the "
+        "slopes demo headless (its own 5 balls; --sizes does not apply, PyBullet has no such scene)",
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument(
@@ -284,6 +293,8 @@ def main(argv: list[str] | None = None) -> int:
         plan += [("pile", n) for n in (args.sizes or [1_000, 10_000])]
     if args.workload in ("settled", "all"):
         plan += [("settled", n) for n in (args.sizes or [1_000, 10_000, 100_000])]
+    if args.workload in ("slopes", "all"):
+        plan += [("slopes", 0)]
     machine = platform.processor() or platform.machine()
     versions = f"Python {platform.python_version()}, NumPy {np.__version__}"
     print(f"ballpit bench: {machine}, {versions}, dt = 1/240 s, RK4, each row in its own process")
@@ -294,6 +305,7 @@ def main(argv: list[str] | None = None) -> int:
     for workload, n in plan:
         steps = args.steps or 240  # one simulated second
         with_pybullet = args.pybullet and (args.pybullet_up_to is None or n <= args.pybullet_up_to)
+        with_pybullet = with_pybullet and workload != "slopes"
         # PyBullet first, so ballpit's row can show the ratio to it as soon as it is printed.
         engines = (["pybullet"] if with_pybullet else []) + ["ballpit"]
         for engine in engines:
