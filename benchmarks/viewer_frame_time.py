@@ -85,8 +85,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     width, height = (int(v) for v in args.size.lower().split("x"))
 
+    from ballpit.allocator import keep_freed_memory
     from ballpit.viewer import backend
 
+    keep_freed_memory()  # as `ballpit view` does
     backend.use_headless()
     from OpenGL import GL
 
