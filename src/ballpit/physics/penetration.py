@@ -30,7 +30,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
     x = state.body[:, X]
     pos = with_static(x)
     if len(c) >= solver.JACOBI_FROM:  # all contacts at once per sweep, with mass splitting
-        sweeps = 2 * SWEEPS
+        sweeps = 2 * SWEEPS  # a split ball moves only its share per sweep: twice the Gauss–Seidel count
         jacobi.separate(c.a, c.b, c.normal, c.gap, rows.inv_mass_a, rows.inv_mass_b, pos, sweeps)
     else:
         _separate_by_colour(c, rows, pos)

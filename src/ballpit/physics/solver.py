@@ -12,7 +12,9 @@ Dynamics with Temporal Coherence", GDC 2005; Box2D's contact_solver.c):
   ground it slows a rolling ball at (5/7)·ρ·g.
 
 Contacts that share no ball are independent, so they are grouped into colours and each colour is
-solved as one set of array operations; Gauss–Seidel order holds between colours.
+solved as one set of array operations; Gauss–Seidel order holds between colours. From JACOBI_FROM
+contacts on (a pile), ``solve`` hands the same contact model to ``jacobi.py``, which updates every
+contact at once per sweep.
 
 Balls are rows 0…N−1 of the velocity arrays; row N is the static world (planes), with zero inverse
 mass, so a sphere–plane contact is a sphere–sphere contact whose second body never moves.

@@ -124,7 +124,8 @@ class World:
     crowd_limit = _model_number(
         "crowd_limit",
         "A step in which more pairs than this may meet is taken whole, with speculative contacts "
-        "(inf: always split the step at each impact; 0: take every step with an impact whole).",
+        "(inf: always split the step at each impact; 0: take every step with an impact whole). "
+        "Among 256 kept pairs or more (a pile) any meeting does, unless this is inf.",
         nonnegative=True,
         infinite=True,
     )
