@@ -1,0 +1,141 @@
+"""The all-contacts-at-once solve (Jacobi with mass splitting) reaches the same answers the
+colour-by-colour solve does: checked against a resting column's closed form."""
+
+import numpy as np
+import pytest
+
+from ballpit.physics import jacobi, solver
+from ballpit.physics.impulses import Impulses
+from ballpit.physics.rows import ContactRows
+
+G, DT, R, M = 9.81, 1 / 240, 0.5, 2.0
+
+
+def column(n: int) -> ContactRows:
+    """n balls stacked on the floor: contact i holds ball i on ball i − 1 (ball 0 on the floor, the
+    static row n)."""
+    a, b = np.arange(n), np.r_[n, np.arange(n - 1)]
+    on_floor = b == n
+    normal = np.tile([0.0, 1.0, 0.0], (n, 1))
+    inv_mass, inv_inertia = 1 / M, 1 / (0.4 * M * R * R)
+    return ContactRows(
+        a=a,
+        b=b,
+        normal=normal,
+        arm_a=-R * normal,
+        arm_b=np.where(on_floor[:, None], 0.0, R * normal),
+        inv_mass_a=np.full(n, inv_mass),
+        inv_mass_b=np.where(on_floor, 0.0, inv_mass),
+        inv_inertia_a=np.full(n, inv_inertia),
+        inv_inertia_b=np.where(on_floor, 0.0, inv_inertia),
+        restitution=np.zeros(n),
+        friction=np.full(n, 0.5),
+        rolling=np.full(n, 0.01),
+        surface=np.zeros((n, 3)),
+        spin=np.zeros((n, 3)),
+        moving=False,
+        static=n,
+    )
+
+
+def test_a_resting_column_carries_the_weight_above_each_contact():
+    n = 20  # a column converges in about n² sweeps
+    rows = column(n)
+    v = np.zeros((n + 1, 3))
+    v[:n, 1] = -G * DT  # every ball after a step of free fall
+    w = np.zeros((n + 1, 3))
+    imp = jacobi.solve(rows, v, w, np.zeros(n), Impulses.zeros(n), 20_000)
+    # contact i holds the n − i balls from i up: P = (n − i)·m·g·dt
+    assert imp.normal == pytest.approx((n - np.arange(n)) * M * G * DT, rel=1e-6)
+    assert np.abs(v).max() < 1e-7  # every ball stopped (from g·dt = 0.04 m/s)
+    assert np.abs(w).max() == 0.0 and np.abs(imp.friction).max() == 0.0  # nothing to turn or slip
+
+
+def test_the_dispatch_gives_a_column_the_jacobi_solve_from_its_threshold_on():
+    n = solver.JACOBI_FROM
+    rows = column(n)
+    results = []
+    for solve in (solver.solve, jacobi.solve):
+        v = np.zeros((n + 1, 3))
+        v[:n, 1] = -G * DT
+        imp = solve(rows, v, np.zeros((n + 1, 3)), np.zeros(n), Impulses.zeros(n), 7)
+        results.append(imp.normal)
+    # solver.solve asks for JACOBI_SWEEPS sweeps per iteration
+    v = np.zeros((n + 1, 3))
+    v[:n, 1] = -G * DT
+    direct = jacobi.solve(rows, v, np.zeros((n + 1, 3)), np.zeros(n), Impulses.zeros(n),
+                          7 * solver.JACOBI_SWEEPS)  # fmt: skip
+    assert np.array_equal(results[0], direct.normal)
+
+
+def test_a_falling_column_is_never_pushed_upwards_while_it_is_stopped():
+    """Sweep by sweep the column's balls only slow down: none is pushed past rest."""
+    n = 80
+    rows = column(n)
+    v = np.zeros((n + 1, 3))
+    v[:n, 1] = -G * DT
+    w = np.zeros((n + 1, 3))
+    imp = Impulses.zeros(n)
+    for _ in range(200):
+        jacobi.solve(rows, v, w, np.zeros(n), imp, 1)
+        assert v[:n, 1].max() <= 1e-15
+
+
+def test_separation_puts_an_overlapping_column_exactly_touching():
+    n = 20
+    rows = column(n)
+    squeeze = 0.01  # every contact overlaps by 1 cm
+    y = R + np.arange(n) * (2 * R - squeeze)
+    pos = np.zeros((n + 1, 3))
+    pos[:n, 1] = y
+    gap = np.r_[y[0] - R, np.diff(y) - 2 * R]
+    jacobi.separate(rows.a, rows.b, rows.normal, gap, rows.inv_mass_a, rows.inv_mass_b, pos, 20_000)
+    assert pos[:n, 1] == pytest.approx(R + 2 * R * np.arange(n), abs=1e-9)  # the floor does not move
+    assert np.abs(pos[:n, [0, 2]]).max() == 0.0
+
+
+def landing_on_one_ball(k: int) -> ContactRows:
+    """k balls (0 … k−1) landing at once on ball k, which sits on the floor (static row k + 1); the
+    last contact holds ball k on the floor."""
+    n = k + 1
+    angles = 2 * np.pi * np.arange(k) / k
+    tilt = np.radians(30.0)
+    up = np.stack((np.sin(tilt) * np.cos(angles), np.full(k, np.cos(tilt)), np.sin(tilt) * np.sin(angles)), 1)
+    normal = np.vstack((up, [0.0, 1.0, 0.0]))
+    a, b = np.r_[np.arange(k), k], np.r_[np.full(k, k), n]
+    on_floor = b == n
+    inv_mass, inv_inertia = 1 / M, 1 / (0.4 * M * R * R)
+    return ContactRows(
+        a=a,
+        b=b,
+        normal=normal,
+        arm_a=-R * normal,
+        arm_b=np.where(on_floor[:, None], 0.0, R * normal),
+        inv_mass_a=np.full(n, inv_mass),
+        inv_mass_b=np.where(on_floor, 0.0, inv_mass),
+        inv_inertia_a=np.full(n, inv_inertia),
+        inv_inertia_b=np.where(on_floor, 0.0, inv_inertia),
+        restitution=np.zeros(n),
+        friction=np.zeros(n),
+        rolling=np.zeros(n),
+        surface=np.zeros((n, 3)),
+        spin=np.zeros((n, 3)),
+        moving=False,
+        static=n,
+    )
+
+
+def test_mass_splitting_never_pushes_a_ball_faster_than_anything_arrived():
+    """Six balls land at 1 m/s on one ball on the floor. Plain Jacobi gives each contact the whole
+    ball underneath, so the six pushes add up and drive it into the floor at several m/s; split
+    masses keep every sweep's velocities within the arrival speed."""
+    k, u = 6, 1.0
+    rows = landing_on_one_ball(k)
+    v = np.zeros((k + 2, 3))
+    v[:k, 1] = -u
+    w = np.zeros((k + 2, 3))
+    imp = Impulses.zeros(k + 1)
+    for _ in range(50):
+        jacobi.solve(rows, v, w, np.zeros(k + 1), imp, 1)
+        assert np.linalg.norm(v, axis=1).max() <= u + 1e-12
+    assert imp.normal.min() > 0.0  # every contact took part
