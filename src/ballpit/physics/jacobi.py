@@ -33,7 +33,27 @@ def _skew(n: np.ndarray) -> np.ndarray:
     return k
 
 
-class _Contacts:
+class _Ends:
+    """Both ends of K contacts as columns of a compact array of the M balls they touch: ``ends`` holds
+    each contact's a then b, ``share`` each ball's number of contacts (its mass is split that many
+    ways), and ``add_up`` adds per-end values back per ball with one ``np.bincount``."""
+
+    def __init__(self, a: np.ndarray, b: np.ndarray, rows: int) -> None:
+        self.k = len(a)
+        self.balls, self.ends = np.unique(np.concatenate((a, b)), return_inverse=True)
+        self.m = len(self.balls)
+        self.share = np.bincount(self.ends, minlength=self.m).astype(float)
+        # where each of the (rows, 2K) per-end entries lands in the flattened (rows, M) per-ball array
+        self.scatter = (np.arange(rows)[:, None] * self.m + self.ends[None, :]).ravel()
+
+    def add_up(self, values: np.ndarray) -> np.ndarray:
+        """(rows, 2K) values per contact end, summed per ball: (rows, M)."""
+        rows = len(values)
+        summed = np.bincount(self.scatter, weights=values.ravel(), minlength=rows * self.m)
+        return summed.reshape(rows, self.m)
+
+
+class _Contacts(_Ends):
     """What the sweeps need of the contacts, gathered once per solve, with vectors as (3, K) rows.
 
     Velocities are the rows of one (6, M) array [v; ω] of just the M balls the contacts touch; ``ends``
@@ -45,14 +65,8 @@ class _Contacts:
     """
 
     def __init__(self, contacts: ContactRows) -> None:
-        k = len(contacts)
-        self.k = k
-        self.balls, self.ends = np.unique(np.concatenate((contacts.a, contacts.b)), return_inverse=True)
-        m = len(self.balls)
-        self.m = m
-        # where each of the (6, 2K) impulse entries lands in the flattened (6, M) velocities
-        self.scatter = (np.arange(6)[:, None] * m + self.ends[None, :]).ravel()
-        share = np.bincount(self.ends, minlength=m).astype(float)  # contacts per ball
+        super().__init__(contacts.a, contacts.b, 6)  # rows v and ω
+        k, m, share = self.k, self.m, self.share
         sa, sb = share[self.ends[:k]], share[self.ends[k:]]
         ima, imb = contacts.inv_mass_a, contacts.inv_mass_b
         iia, iib = contacts.inv_inertia_a, contacts.inv_inertia_b
@@ -141,7 +155,7 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
 
         push[:3, :k] = linear
         np.negative(linear, out=push[:3, k:])
-        total = np.bincount(c.scatter, weights=push.ravel(), minlength=6 * c.m).reshape(6, c.m)
+        total = c.add_up(push)
         total *= c.inverse
         vw += total
         if change < CONVERGED:
@@ -159,11 +173,8 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
     proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world."""
-    k = len(a)
-    balls, ends = np.unique(np.concatenate((a, b)), return_inverse=True)
-    m = len(balls)
-    scatter = (np.arange(3)[:, None] * m + ends[None, :]).ravel()
-    share = np.bincount(ends, minlength=m).astype(float)  # contacts per ball
+    e = _Ends(a, b, 3)  # rows x, y, z
+    k, balls, ends, share = e.k, e.balls, e.ends, e.share
     wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
     fa, fb = wa / (wa + wb), -wb / (wa + wb)  # each end's part of the contact's correction
     n = np.ascontiguousarray(normal.T)
@@ -177,6 +188,6 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
         np.multiply(d, fa, out=move[:, :k])
         np.multiply(d, fb, out=move[:, k:])
         # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
-        x += np.bincount(scatter, weights=move.ravel(), minlength=3 * m).reshape(3, m) / share
+        x += e.add_up(move) / share
     pos[balls] = x.T
     pos[-1] = 0.0
