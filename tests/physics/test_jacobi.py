@@ -11,12 +11,11 @@ from ballpit.physics.rows import ContactRows
 G, DT, R, M = 9.81, 1 / 240, 0.5, 2.0
 
 
-def column(n: int) -> ContactRows:
-    """n balls stacked on the floor: contact i holds ball i on ball i − 1 (ball 0 on the floor, the
-    static row n)."""
-    a, b = np.arange(n), np.r_[n, np.arange(n - 1)]
+def equal_balls(a: np.ndarray, b: np.ndarray, normal: np.ndarray, friction: float,
+                rolling: float) -> ContactRows:  # fmt: skip
+    """Contacts between balls of mass M and radius R; b = len(a) is the floor (the static row)."""
+    n = len(a)
     on_floor = b == n
-    normal = np.tile([0.0, 1.0, 0.0], (n, 1))
     inv_mass, inv_inertia = 1 / M, 1 / (0.4 * M * R * R)
     return ContactRows(
         a=a,
@@ -29,13 +28,20 @@ def column(n: int) -> ContactRows:
         inv_inertia_a=np.full(n, inv_inertia),
         inv_inertia_b=np.where(on_floor, 0.0, inv_inertia),
         restitution=np.zeros(n),
-        friction=np.full(n, 0.5),
-        rolling=np.full(n, 0.01),
+        friction=np.full(n, friction),
+        rolling=np.full(n, rolling),
         surface=np.zeros((n, 3)),
         spin=np.zeros((n, 3)),
         moving=False,
         static=n,
     )
+
+
+def column(n: int) -> ContactRows:
+    """n balls stacked on the floor: contact i holds ball i on ball i − 1 (ball 0 on the floor, the
+    static row n)."""
+    normal = np.tile([0.0, 1.0, 0.0], (n, 1))
+    return equal_balls(np.arange(n), np.r_[n, np.arange(n - 1)], normal, friction=0.5, rolling=0.01)
 
 
 def test_a_resting_column_carries_the_weight_above_each_contact():
@@ -97,32 +103,11 @@ def test_separation_puts_an_overlapping_column_exactly_touching():
 def landing_on_one_ball(k: int) -> ContactRows:
     """k balls (0 … k−1) landing at once on ball k, which sits on the floor (static row k + 1); the
     last contact holds ball k on the floor."""
-    n = k + 1
     angles = 2 * np.pi * np.arange(k) / k
     tilt = np.radians(30.0)
     up = np.stack((np.sin(tilt) * np.cos(angles), np.full(k, np.cos(tilt)), np.sin(tilt) * np.sin(angles)), 1)
     normal = np.vstack((up, [0.0, 1.0, 0.0]))
-    a, b = np.r_[np.arange(k), k], np.r_[np.full(k, k), n]
-    on_floor = b == n
-    inv_mass, inv_inertia = 1 / M, 1 / (0.4 * M * R * R)
-    return ContactRows(
-        a=a,
-        b=b,
-        normal=normal,
-        arm_a=-R * normal,
-        arm_b=np.where(on_floor[:, None], 0.0, R * normal),
-        inv_mass_a=np.full(n, inv_mass),
-        inv_mass_b=np.where(on_floor, 0.0, inv_mass),
-        inv_inertia_a=np.full(n, inv_inertia),
-        inv_inertia_b=np.where(on_floor, 0.0, inv_inertia),
-        restitution=np.zeros(n),
-        friction=np.zeros(n),
-        rolling=np.zeros(n),
-        surface=np.zeros((n, 3)),
-        spin=np.zeros((n, 3)),
-        moving=False,
-        static=n,
-    )
+    return equal_balls(np.r_[np.arange(k), k], np.r_[np.full(k, k), k + 1], normal, friction=0.0, rolling=0.0)
 
 
 def test_mass_splitting_never_pushes_a_ball_faster_than_anything_arrived():
