@@ -67,6 +67,13 @@ def simulate(scene: Path, steps: int, out: Path, workdir: Path) -> None:
     assert proc.returncode == 0, proc.stderr
 
 
+def assert_same_trajectory(record, expected) -> None:
+    """Every trajectory column of ``record`` equals ``expected``'s, dtype and bits."""
+    for column in TRAJECTORY_COLUMNS:
+        assert record[column].dtype == expected[column].dtype, column
+        assert np.array_equal(record[column], expected[column]), column  # bit for bit
+
+
 @needs_xdotool
 def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_path):
     scene = tmp_path / "slopes.toml"
@@ -90,10 +97,7 @@ def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_
     assert steps > 100, steps
     assert f"recorded {steps} steps (5 balls) to run.npz" in out
     simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
-    expected = np.load(tmp_path / "sim.npz")
-    for column in TRAJECTORY_COLUMNS:
-        assert record[column].dtype == expected[column].dtype, column
-        assert np.array_equal(record[column], expected[column]), column  # bit for bit
+    assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
 @needs_xdotool
@@ -129,9 +133,7 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
     steps = len(times) - 1
     assert steps > 100, steps
     simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
-    expected = np.load(tmp_path / "sim.npz")
-    for column in TRAJECTORY_COLUMNS:
-        assert np.array_equal(record[column], expected[column]), column  # bit for bit
+    assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
 @needs_xdotool
@@ -183,9 +185,7 @@ def test_the_close_button_writes_the_record_and_a_reset_starts_the_timeline_agai
     writer = TrajectoryWriter(tmp_path / "sim.npz", len(world.spheres))
     run(world, r["steps_since_reset"] * live.timestep, dt=live.timestep, trajectory=writer)
     writer.commit()
-    expected = np.load(tmp_path / "sim.npz")
-    for column in TRAJECTORY_COLUMNS:
-        assert np.array_equal(record[column], expected[column]), column
+    assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
 def test_a_bad_record_path_is_a_one_line_error_before_any_window(tmp_path):
