@@ -20,17 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .impulses import CONVERGED, Impulses
+from .impulses import CONVERGED, Impulses, skew
 from .rows import ContactRows
-
-
-def _skew(n: np.ndarray) -> np.ndarray:
-    """(3, 3, K) matrices [n]× with [n]×·s = n × s, so a batch of cross products is one einsum."""
-    k = np.zeros((3, 3, n.shape[1]))
-    k[0, 1], k[0, 2] = -n[2], n[1]
-    k[1, 0], k[1, 2] = n[2], -n[0]
-    k[2, 0], k[2, 1] = -n[1], n[0]
-    return k
 
 
 class _Ends:
@@ -74,7 +65,7 @@ class _Contacts(_Ends):
         self.minus_ra, self.minus_rb = -ra, -rb
         self.arms = np.concatenate((ra, rb))  # each end's lever arm ρ, in the order of ``ends``
         self.n = np.ascontiguousarray(contacts.normal.T)
-        self.nx = _skew(self.n)
+        self.nx = np.ascontiguousarray(skew(contacts.normal).transpose(1, 2, 0))  # (3, 3, K): [n]×
         # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts):
         # normal, then tangential (friction) and angular (rolling resistance) stacked as (2, 1, K)
         self.m_n = 1.0 / (sa * ima + sb * imb)
