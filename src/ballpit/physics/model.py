@@ -79,6 +79,7 @@ class Model:
         self.restitution_threshold: float | None = None
         self.solver_iterations = SOLVER_ITERATIONS
         self.crowd_limit: float = CROWD_LIMIT
+        self.sleep = False  # whether still islands fall asleep (sleeping.py)
 
     def append_spheres(self, n: int, *, radius, mass, restitution, friction, rolling_friction,
                        hollow) -> slice:  # fmt: skip

@@ -10,7 +10,7 @@ found again every step, from the kept boxes and the plane's sweep over the step.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -48,6 +48,21 @@ class KeptPairs:
     def __len__(self) -> int:
         return len(self.pair_i) + len(self.sphere)
 
+    def among(self, awake: np.ndarray | None) -> KeptPairs:
+        """The pairs with an awake ball in them (all of them when ``awake`` is None): two sleeping balls,
+        or a sleeping ball and a plane, are neither measured nor solved (``sleeping.py``)."""
+        if awake is None:
+            return self
+        balls, spheres = awake[self.pair_i] | awake[self.pair_j], awake[self.sphere]
+        return replace(
+            self,
+            pair_i=self.pair_i[balls],
+            pair_j=self.pair_j[balls],
+            sphere=self.sphere[spheres],
+            plane=self.plane[spheres],
+            side=self.side[spheres],
+        )
+
     def escaped(self, model: Model, state: State, accel: np.ndarray, h: float) -> bool:
         """True when some ball's path for the next ``h`` leaves the box or sphere it was paired from."""
         body, radius = state.body, model.spheres.radius
@@ -67,10 +82,14 @@ class KeptPairs:
 
 class PairCache:
     """The kept pairs between steps. ``for_step`` reuses them while they still cover every path;
-    ``renew`` replaces them when a path changes inside a step (a bounce or a contact force)."""
+    ``renew`` replaces them when a path changes inside a step (a bounce or a contact force).
+
+    While some balls sleep, ``awake`` masks the balls and both hand out only the pairs with an awake
+    ball in them (the kept pairs themselves stay whole)."""
 
     def __init__(self) -> None:
         self.kept: KeptPairs | None = None
+        self.awake: np.ndarray | None = None
 
     def for_step(self, model: Model, state: State, accel: np.ndarray, dt: float) -> KeptPairs:
         """The pairs for a step whose free acceleration is ``accel``: kept ones if they still hold."""
@@ -81,13 +100,13 @@ class PairCache:
         if model.moving_planes():  # the planes moved since the pairs were found
             c.sphere, c.plane = plane_pairs(model, state, c.lo, c.hi, dt)
         c.side = plane_sides(model, state, c.sphere, c.plane)
-        return c
+        return c.among(self.awake)
 
     def renew(self, model: Model, state: State, h: float, ahead: float, accel: np.ndarray,
               free: np.ndarray) -> KeptPairs:  # fmt: skip
         """Find pairs afresh and keep them (they cover ``ahead`` seconds, so later steps reuse them)."""
         self.kept = find_pairs(model, state, h, ahead, accel, free)
-        return self.kept
+        return self.kept.among(self.awake)
 
 
 def plane_sides(model: Model, state: State, sphere: np.ndarray, plane: np.ndarray) -> np.ndarray:

@@ -20,6 +20,7 @@ STAGES = (
     "resting solve",
     "time of impact",
     "integrate",
+    "sleep",
 )
 
 

@@ -65,6 +65,9 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
     sph, pl = model.spheres, model.planes
     with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
     radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
+    if state.sleep.any:  # a sleeping ball an awake one leans on holds like a plane (sleeping.py)
+        held = np.append(state.sleep.asleep, False)
+        inv_mass[held], inv_inertia[held] = 0.0, 0.0
     on_plane = c.kind == SPHERE_PLANE
     p = np.where(on_plane, c.other, 0)
     o = np.where(on_plane, 0, c.other)

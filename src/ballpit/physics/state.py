@@ -71,14 +71,56 @@ def plane_pose_columns() -> Columns:
     )
 
 
+class Sleep:
+    """Per-ball sleep bookkeeping (the rules are in ``sleeping.py``), kept with the state so snapshots
+    carry it."""
+
+    def __init__(self) -> None:
+        self.rest = np.zeros(0)  # seconds each ball has been still
+        self.asleep = np.zeros(0, bool)
+        self.island = np.zeros(0, np.int64)  # which island a sleeping ball fell asleep with
+        self.pose = np.zeros((0, 7))  # x and q of each sleeping ball when it fell asleep
+        self.islands = 0  # islands put to sleep so far (their ids)
+        self.context: tuple | None = None  # what every sleeping ball's rest depends on
+
+    def fit(self, n: int) -> None:
+        """Room for ``n`` balls: balls added since the last step are awake."""
+        old = len(self.rest)
+        if old == n:
+            return
+        extra = n - old
+        self.rest = np.concatenate((self.rest[:n], np.zeros(max(extra, 0))))
+        self.asleep = np.concatenate((self.asleep[:n], np.zeros(max(extra, 0), bool)))
+        self.island = np.concatenate((self.island[:n], np.zeros(max(extra, 0), np.int64)))
+        self.pose = np.concatenate((self.pose[:n], np.zeros((max(extra, 0), 7))))
+
+    @property
+    def any(self) -> bool:
+        return bool(self.asleep.any())
+
+    def wake(self, balls: np.ndarray) -> None:
+        """Wake the islands of the sleeping balls ``balls`` (a mask or indices), whole."""
+        ids = np.unique(self.island[balls][self.asleep[balls]])
+        if ids.size == 0:
+            return
+        woken = self.asleep & np.isin(self.island, ids)
+        self.asleep[woken] = False
+        self.rest[woken] = 0.0
+
+    def wake_all(self) -> None:
+        self.asleep[:] = False
+        self.rest[:] = 0.0
+
+
 class State:
-    """What a step advances: the (N, 13) block ``[x v q ω]`` of every ball, each plane's pose, and the
-    world time (s)."""
+    """What a step advances: the (N, 13) block ``[x v q ω]`` of every ball, each plane's pose, the
+    world time (s), and which balls are asleep (``sleeping.py``)."""
 
     def __init__(self) -> None:
         self._rows = Columns({"body": ((STATE_WIDTH,), float)})
         self.planes = plane_pose_columns()
         self.time = 0.0
+        self.sleep = Sleep()
 
     @property
     def body(self) -> np.ndarray:

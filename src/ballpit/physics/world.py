@@ -13,7 +13,7 @@ from time import perf_counter
 
 import numpy as np
 
-from . import energy, moving_planes, narrowphase, strategies, validation
+from . import energy, moving_planes, narrowphase, sleeping, strategies, validation
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .contacts import ContactRecord, EventLog
 from .forces import ForceTerm, free_acceleration
@@ -62,6 +62,7 @@ class World:
         linear_drag: float = 0.0,
         angular_drag: float = 0.0,
         restitution_threshold: float | None = None,
+        sleep: bool = False,
     ) -> None:
         self.model = Model()
         self.state = State()
@@ -70,6 +71,7 @@ class World:
         self.linear_drag = linear_drag
         self.angular_drag = angular_drag
         self.restitution_threshold = restitution_threshold
+        self.sleep = sleep
         self.crowded_steps = 0  # how many steps were taken whole, with speculative contacts
         self.profile = StepProfile()  # the last step's time per stage (profile.py)
         self._pairs = PairCache()
@@ -140,6 +142,27 @@ class World:
         if value is not None:
             value = validation.number("restitution_threshold", value, nonnegative=True)
         self.model.restitution_threshold = value
+
+    @property
+    def sleep(self) -> bool:
+        """Whether balls that have stayed still together for half a second fall asleep (cost nothing,
+        move not at all) until something reaches them (sleeping.py). Off by default."""
+        return self.model.sleep
+
+    @sleep.setter
+    def sleep(self, value: bool) -> None:
+        if not isinstance(value, bool | np.bool_):
+            raise TypeError(f"sleep must be true or false, got {value!r}")
+        self.model.sleep = bool(value)
+
+    @property
+    def asleep(self) -> np.ndarray:
+        """Which balls are asleep now (a read-only copy, one flag per ball)."""
+        sleep = self.state.sleep
+        sleep.fit(self.model.spheres.count)
+        flags = sleep.asleep.copy()
+        flags.flags.writeable = False
+        return flags
 
     # ------------------------------------------------------------------ bodies
     @property
@@ -264,11 +287,29 @@ class World:
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
                                model.bounce_threshold(dt), EventLog(), StepProfile())  # fmt: skip
         prof = step.profile
-        free, ang = free_acceleration(state.body, step.forces)
+        with prof.stage("sleep"):
+            sleep = state.sleep
+            sleeping.before_step(model, state, sleep, model.sleep)
+        free, ang, unheld = self._free_acceleration(step)
         with prof.stage("pairs"):
             pairs = self._pairs.for_step(model, state, free, dt)
         with prof.stage("narrow phase"):
             contacts = narrowphase.contact_points(model, state, pairs)
+        # Pairs within reach (sleeping balls counted as falling, as they will once awake) join islands;
+        # reaching a sleeping ball wakes its island.
+        if model.sleep:
+            with prof.stage("sleep"):
+                reach = strategies.speculative_reach(step, contacts, unheld)
+                woken = sleeping.reached(contacts, sleep.asleep, reach) if sleep.any else None
+            if woken is not None and woken.any():
+                sleep.wake(woken)
+                free, ang, unheld = self._free_acceleration(step)
+                with prof.stage("pairs"):
+                    pairs = self._pairs.for_step(model, state, free, dt)
+                with prof.stage("narrow phase"):
+                    contacts = narrowphase.contact_points(model, state, pairs)
+                with prof.stage("sleep"):
+                    reach = strategies.speculative_reach(step, contacts, unheld)
         with prof.stage("crowd test"):
             crowd = strategies.crowded_contacts(step, contacts, free)
         if crowd is None:
@@ -276,6 +317,9 @@ class World:
         else:
             strategies.whole_with_speculative_contacts(step, contacts, pairs, crowd)
             self.crowded_steps += 1
+        if model.sleep:
+            with prof.stage("sleep"):
+                sleeping.after_step(model, state, sleep, contacts, reach, dt)
         validation.undo_non_finite_step(state.body, before)
         state.time += dt
         record = step.events.record()
@@ -283,6 +327,20 @@ class World:
         prof.total = perf_counter() - began
         self.profile = prof
         return record
+
+    def _free_acceleration(self, step: strategies.Step) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The free linear and angular accelerations at the step's start, and the linear ones had no
+        ball been asleep. While some sleep, the step's force terms get one more that holds them
+        (``step.forces`` changes)."""
+        step.forces = self.model.forces()
+        sleep = self.state.sleep
+        self._pairs.awake = ~sleep.asleep if sleep.any else None
+        free, ang = free_acceleration(self.state.body, step.forces)
+        if not sleep.any:
+            return free, ang, free
+        held = sleeping.hold(sleep, (free, ang))
+        step.forces.append(held)
+        return free + held.lin, ang + held.ang, free
 
     # ------------------------------------------------------------------ snapshots
     def snapshot(self) -> Snapshot:

@@ -76,6 +76,7 @@ class Builder:
             restitution_threshold=e.number(
                 "restitution_threshold", d["restitution_threshold"], nonnegative=True
             ),
+            sleep=e.boolean("sleep", bool(d["sleep"])),
         )
         return params, timestep, e.number("duration", None, positive=True)
 

@@ -22,7 +22,8 @@ def _defaults(function: Callable, names: tuple[str, ...]) -> dict[str, object]:
 
 # What the [world] table passes to World(...), and its defaults there.
 WORLD_DEFAULTS = _defaults(
-    World.__init__, ("gravity", "integrator", "linear_drag", "angular_drag", "restitution_threshold")
+    World.__init__,
+    ("gravity", "integrator", "linear_drag", "angular_drag", "restitution_threshold", "sleep"),
 )
 TIMESTEP_DEFAULT = DEFAULT_TIMESTEP  # s per physics step, when [world] gives no timestep
 INTEGRATORS = INTEGRATOR_NAMES
@@ -76,6 +77,7 @@ WORLD_KEYS = (
     "linear_drag",
     "angular_drag",
     "restitution_threshold",
+    "sleep",
     "duration",
 )
 CAMERA_KEYS = ("position", "look_at")

@@ -78,6 +78,8 @@ def _world_table(world: object, timestep: float) -> Table:
     table["angular_drag"] = float(world.angular_drag)  # type: ignore[attr-defined]
     if world.restitution_threshold is not None:  # type: ignore[attr-defined]
         table["restitution_threshold"] = float(world.restitution_threshold)  # type: ignore[attr-defined]
+    if world.sleep:  # type: ignore[attr-defined]
+        table["sleep"] = True
     return table
 
 

@@ -1,0 +1,175 @@
+"""Sleeping: still islands fall asleep after half a second, cost nothing and wake when reached."""
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.physics.sleeping import SLEEP_SPEED, TIME_TO_SLEEP, islands
+
+DT = 1 / 240
+
+
+def resting_ball(sleep: bool = True) -> tuple[ballpit.World, object]:
+    world = ballpit.World(sleep=sleep)
+    world.add_plane(size=10.0)
+    ball = world.add_sphere(position=(0, 0.5, 0), radius=0.5)
+    return world, ball
+
+
+def row_of_touching_balls(world: ballpit.World, count: int, r: float = 0.1) -> np.ndarray:
+    """``count`` balls touching in a row along x, resting on the floor."""
+    x = np.arange(count) * 2 * r
+    return world.add_spheres(np.column_stack((x, np.full(count, r), np.zeros(count))), radius=r)
+
+
+def test_a_resting_ball_falls_asleep_after_the_time_to_sleep_and_then_does_not_move_at_all():
+    world, _ = resting_ball()
+    steps_to_sleep = round(TIME_TO_SLEEP / DT)
+    for _ in range(steps_to_sleep - 2):
+        world.step(DT)
+    assert not world.asleep[0]
+    for _ in range(4):
+        world.step(DT)
+    assert world.asleep[0]
+    before = world.state.body.copy()
+    for _ in range(240):
+        contacts = world.step(DT)
+        assert len(contacts) == 0  # nothing is solved for a sleeping ball
+    assert np.array_equal(world.state.body, before)  # bit for bit where it fell asleep
+
+
+def test_with_sleeping_off_a_resting_ball_never_falls_asleep():
+    world, _ = resting_ball(sleep=False)
+    for _ in range(480):
+        world.step(DT)
+    assert not world.asleep.any()
+    assert ballpit.World().sleep is False
+
+
+def test_a_moving_ball_never_falls_asleep():
+    # sliding at 1 m/s on a frictionless floor for two seconds: never still
+    world = ballpit.World(sleep=True)
+    world.add_plane(friction=0.0)
+    world.add_sphere(position=(0, 0.5, 0), radius=0.5, velocity=(1.0, 0, 0), friction=0.0)
+    for _ in range(480):
+        world.step(DT)
+    assert not world.asleep.any()
+    assert world.spheres.positions[0, 0] == pytest.approx(2.0 + 1 / 240, abs=0.02)
+
+
+def test_touching_balls_sleep_together_only_when_all_are_still():
+    world = ballpit.World(sleep=True)
+    world.add_plane(friction=0.0)
+    row = row_of_touching_balls(world, 5)
+    far = world.add_sphere(position=(5.0, 0.1, 0.0), radius=0.1, velocity=(0.5, 0, 0), friction=0.0).index
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    asleep = world.asleep
+    assert asleep[row].all()
+    assert not asleep[far]
+
+
+def test_a_ball_dropped_on_a_sleeping_row_wakes_it_and_the_impact_moves_the_row():
+    world = ballpit.World(sleep=True)
+    world.add_plane(friction=0.0)
+    row = row_of_touching_balls(world, 5)
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    assert world.asleep[row].all()
+    # a ball rolling along the floor hits the end of the row (Newton's cradle)
+    striker = world.add_sphere(
+        position=(-0.5, 0.1, 0.0), radius=0.1, velocity=(2.0, 0, 0), restitution=1.0, friction=0.0
+    ).index
+    for _ in range(120):
+        world.step(DT)
+    assert not world.asleep[row].any()
+    v = world.spheres.velocities
+    assert v[striker, 0] < 0.5  # it gave its momentum away instead of passing through
+    assert v[row[-1], 0] > 0.5  # the far end of the row flew off
+    x = world.spheres.positions[:, 0]
+    assert np.all(np.diff(x[[striker, *row]]) >= 0.2 - 1e-3)  # nothing passed through anything
+
+
+def test_setting_a_sleeping_balls_velocity_wakes_it():
+    world, ball = resting_ball()
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    assert world.asleep[0]
+    ball.velocity = (0.0, 3.0, 0.0)
+    world.step(DT)
+    assert not world.asleep[0]
+    # thrown straight up: v = 3 − g·t after the first step
+    assert ball.velocity[1] == pytest.approx(3.0 - 9.81 * DT, abs=1e-9)
+
+
+def test_moving_a_sleeping_ball_by_hand_wakes_it_and_it_falls():
+    world, ball = resting_ball()
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    ball.position = (0.0, 2.5, 0.0)
+    for _ in range(24):
+        world.step(DT)
+    t = 24 * DT
+    assert ball.position[1] == pytest.approx(2.5 - 0.5 * 9.81 * t * t, abs=1e-9)
+
+
+def test_changing_gravity_wakes_every_ball():
+    world, ball = resting_ball()
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    world.gravity = (0.0, 9.81, 0.0)  # upwards: the ball must fall off the floor, up
+    for _ in range(24):
+        world.step(DT)
+    assert not world.asleep[0]
+    assert ball.position[1] > 0.5 + 0.4 * 9.81 * (24 * DT) ** 2
+
+
+def test_switching_sleeping_off_wakes_every_ball():
+    world, _ = resting_ball()
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    world.sleep = False
+    world.step(DT)
+    assert not world.asleep.any()
+
+
+def test_a_restored_snapshot_repeats_a_run_with_sleeping_bit_for_bit():
+    world = ballpit.World(sleep=True)
+    world.add_plane(friction=0.5, rolling_friction=0.2)
+    rng = np.random.default_rng(3)
+    drop = rng.uniform((-1, 0.3, -1), (1, 1.5, 1), (30, 3))
+    world.add_spheres(drop, radius=0.1, restitution=0.3, rolling_friction=0.2)
+    for _ in range(400):
+        world.step(DT)
+    snap = world.snapshot()
+    for _ in range(200):
+        world.step(DT)
+    first = world.state.body.copy(), world.asleep.copy()
+    world.restore(snap)
+    for _ in range(200):
+        world.step(DT)
+    assert np.array_equal(world.state.body, first[0])
+    assert np.array_equal(world.asleep, first[1])
+    assert first[1].any()
+
+
+def test_sleep_rejects_what_is_not_true_or_false():
+    with pytest.raises(TypeError, match="sleep"):
+        ballpit.World(sleep="yes")
+
+
+def test_islands_are_the_connected_groups_of_touching_balls():
+    # 0-1-2 chained, 3-4, 5 alone, 6-7-8-6 a loop
+    a = np.array([1, 2, 4, 6, 7, 8])
+    b = np.array([0, 1, 3, 7, 8, 6])
+    label = islands(9, a, b)
+    assert label.tolist() == [0, 0, 0, 3, 3, 5, 6, 6, 6]
+
+
+def test_still_means_below_the_sleep_speed_in_translation_and_in_spin():
+    world = ballpit.World(sleep=True, gravity=(0, 0, 0))
+    world.add_sphere(position=(0, 0, 0), radius=0.5, angular_velocity=(0, 0, 1.5 * SLEEP_SPEED / 0.5))
+    world.add_sphere(position=(5, 0, 0), radius=0.5, velocity=(0.5 * SLEEP_SPEED, 0, 0))
+    for _ in range(round(TIME_TO_SLEEP / DT) + 4):
+        world.step(DT)
+    assert world.asleep.tolist() == [False, True]  # spinning at 1.5× the sleep speed; drifting at half
