@@ -57,10 +57,9 @@ def before_step(model: Model, state: State, sleep: Sleep, enabled: bool) -> None
     body = state.body
     idx = np.flatnonzero(sleep.asleep)
     held = body[idx]
-    edited = (held[:, V] != 0.0).any(axis=1) | (held[:, W] != 0.0).any(axis=1)
-    edited |= (held[:, X] != sleep.pose[idx, :3]).any(axis=1) | (held[:, Q] != sleep.pose[idx, 3:]).any(
-        axis=1
-    )
+    moving = (held[:, V] != 0.0).any(axis=1) | (held[:, W] != 0.0).any(axis=1)
+    moved = (np.hstack((held[:, X], held[:, Q])) != sleep.pose[idx]).any(axis=1)
+    edited = moving | moved
     if edited.any():
         sleep.wake(idx[edited])
 
@@ -107,13 +106,19 @@ def islands(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         label = new
 
 
-def after_step(model: Model, state: State, sleep: Sleep, c: ContactPoints, reach: np.ndarray,
+def may_fall_asleep(sleep: Sleep, dt: float) -> bool:
+    """Whether some awake ball will have been still for TIME_TO_SLEEP if it stays still this step."""
+    return bool(((sleep.rest + dt >= TIME_TO_SLEEP) & ~sleep.asleep).any())
+
+
+def after_step(model: Model, state: State, sleep: Sleep, c: ContactPoints, reach: np.ndarray | None,
                dt: float) -> None:  # fmt: skip
     """Update the rest timers and put to sleep the islands whose balls have all been still for
     TIME_TO_SLEEP; wake any sleeping ball the step left moving.
 
     Islands are joined by the ball–ball pairs of ``c`` (measured at the step's start) that touch or
     were within reach of each other (``reach``): the pairs whose balls would wake each other.
+    ``reach`` may be None when no ball was asleep and none ``may_fall_asleep``: then none falls.
     """
     body = state.body
     n = len(body)

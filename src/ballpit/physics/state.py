@@ -84,15 +84,14 @@ class Sleep:
         self.context: tuple | None = None  # what every sleeping ball's rest depends on
 
     def fit(self, n: int) -> None:
-        """Room for ``n`` balls: balls added since the last step are awake."""
-        old = len(self.rest)
-        if old == n:
+        """Room for ``n`` balls (balls are only ever added): those added since the last step are awake."""
+        extra = n - len(self.rest)
+        if extra == 0:
             return
-        extra = n - old
-        self.rest = np.concatenate((self.rest[:n], np.zeros(max(extra, 0))))
-        self.asleep = np.concatenate((self.asleep[:n], np.zeros(max(extra, 0), bool)))
-        self.island = np.concatenate((self.island[:n], np.zeros(max(extra, 0), np.int64)))
-        self.pose = np.concatenate((self.pose[:n], np.zeros((max(extra, 0), 7))))
+        self.rest = np.concatenate((self.rest, np.zeros(extra)))
+        self.asleep = np.concatenate((self.asleep, np.zeros(extra, bool)))
+        self.island = np.concatenate((self.island, np.zeros(extra, np.int64)))
+        self.pose = np.concatenate((self.pose, np.zeros((extra, 7))))
 
     @property
     def any(self) -> bool:

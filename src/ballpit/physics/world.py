@@ -274,10 +274,11 @@ class World:
     def step(self, dt: float) -> ContactRecord:
         """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
 
-        Stages: the kept pairs (found again only when a path leaves its box), the narrow phase, the
-        crowd test, then one of the two strategies (strategies.py): split the step at every impact,
-        or take a crowded step whole with speculative contacts. ``profile`` then holds the step's
-        time per stage.
+        Stages: waking what was changed by hand (sleeping.py), the kept pairs (found again only when
+        a path leaves its box), the narrow phase, waking the islands awake balls reach, the crowd
+        test, then one of the two strategies (strategies.py): split the step at every impact, or take
+        a crowded step whole with speculative contacts; last, still islands fall asleep. ``profile``
+        then holds the step's time per stage.
         """
         dt = validation.number("dt", dt, positive=True)
         began = perf_counter()
@@ -296,8 +297,10 @@ class World:
         with prof.stage("narrow phase"):
             contacts = narrowphase.contact_points(model, state, pairs)
         # Pairs within reach (sleeping balls counted as falling, as they will once awake) join islands;
-        # reaching a sleeping ball wakes its island.
-        if model.sleep:
+        # reaching a sleeping ball wakes its island. Needed only while some ball sleeps or may fall
+        # asleep at the end of this step.
+        reach = None
+        if model.sleep and (sleep.any or sleeping.may_fall_asleep(sleep, dt)):
             with prof.stage("sleep"):
                 reach = strategies.speculative_reach(step, contacts, unheld)
                 woken = sleeping.reached(contacts, sleep.asleep, reach) if sleep.any else None
