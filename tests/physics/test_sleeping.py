@@ -16,10 +16,11 @@ def resting_ball(sleep: bool = True) -> tuple[ballpit.World, object]:
     return world, ball
 
 
-def row_of_touching_balls(world: ballpit.World, count: int, r: float = 0.1) -> np.ndarray:
-    """``count`` balls touching in a row along x, resting on the floor."""
+def row_of_touching_balls(world: ballpit.World, count: int, r: float = 0.1, z: float = 0.0,
+                          **material: float) -> np.ndarray:  # fmt: skip
+    """``count`` balls touching in a row along x at ``z``, resting on the floor."""
     x = np.arange(count) * 2 * r
-    return world.add_spheres(np.column_stack((x, np.full(count, r), np.zeros(count))), radius=r)
+    return world.add_spheres(np.column_stack((x, np.full(count, r), np.full(count, z))), radius=r, **material)
 
 
 def test_a_resting_ball_falls_asleep_after_the_time_to_sleep_and_then_does_not_move_at_all():
@@ -61,15 +62,23 @@ def test_touching_balls_sleep_together_only_when_all_are_still():
     world = ballpit.World(sleep=True)
     world.add_plane(friction=0.0)
     row = row_of_touching_balls(world, 5)
+    # A second row whose last ball spins about the vertical at 10 rad/s (1 m/s at its surface), on
+    # frictionless contacts: it stays in place touching its row, never still.
+    spun = row_of_touching_balls(world, 5, z=1.0, friction=0.0)
+    world.spheres[spun[-1]].angular_velocity = (0.0, 10.0, 0.0)
     far = world.add_sphere(position=(5.0, 0.1, 0.0), radius=0.1, velocity=(0.5, 0, 0), friction=0.0).index
+    ever = np.zeros(len(world.spheres), bool)
     for _ in range(round(TIME_TO_SLEEP / DT) + 4):
         world.step(DT)
-    asleep = world.asleep
-    assert asleep[row].all()
-    assert not asleep[far]
+        ever |= world.asleep
+    assert world.asleep[row].all()
+    assert not ever[
+        spun
+    ].any()  # four still balls never sleep, not even for a step: they touch one that spins
+    assert not ever[far]
 
 
-def test_a_ball_dropped_on_a_sleeping_row_wakes_it_and_the_impact_moves_the_row():
+def test_a_ball_rolling_into_a_sleeping_row_wakes_it_and_the_impact_moves_the_row():
     world = ballpit.World(sleep=True)
     world.add_plane(friction=0.0)
     row = row_of_touching_balls(world, 5)
