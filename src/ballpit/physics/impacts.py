@@ -27,7 +27,7 @@ APPROACH_SPEED = 1e-6
 
 def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
            allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
-           seeds_among: np.ndarray | None = None) -> None:  # fmt: skip
+           seeds_among: np.ndarray | None = None, jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
     """Bounce the contacts that arrive, with their island; velocities change in place.
 
     ``allowance`` (m/s) is how fast each contact may close without being stopped: zero for a
@@ -63,7 +63,7 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
     island = rows.subset(near)
     target = np.where(arriving[near], -island.restitution * vn[near], -allowance[near])
     imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations,
-                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS)  # fmt: skip
+                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
     body = state.body
     body[:, V] = v[:-1]
     body[:, W] = w[:-1]

@@ -59,7 +59,8 @@ class WarmStart:
 
 def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,
                    ang: np.ndarray, h: float, dt: float, target: np.ndarray, warm: WarmStart,
-                   events: EventLog, now: float) -> ConstantPerBall | None:  # fmt: skip
+                   events: EventLog, now: float, jacobi_from: int = solver.JACOBI_FROM
+                   ) -> ConstantPerBall | None:  # fmt: skip
     """Constant contact forces over the next ``h`` seconds that leave each contact's normal speed at
     least ``target`` (0 for a touching contact, −gap/dt for a speculative one) at the interval's end.
 
@@ -78,7 +79,7 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
     solver.warm_start(rows, v, w, imp)
-    solver.solve(rows, v, w, target, imp, model.solver_iterations)
+    solver.solve(rows, v, w, target, imp, model.solver_iterations, jacobi_from=jacobi_from)
     if h >= WARM_START_SPAN * dt:
         warm.keep(keys, imp, h)
     events.add_resting(now, c, keys, imp.normal)

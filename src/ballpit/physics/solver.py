@@ -14,7 +14,8 @@ Dynamics with Temporal Coherence", GDC 2005; Box2D's contact_solver.c):
 Contacts that share no ball are independent, so they are grouped into colours and each colour is
 solved as one set of array operations; Gauss–Seidel order holds between colours. From JACOBI_FROM
 contacts on (a pile), ``solve`` hands the same contact model to ``jacobi.py``, which updates every
-contact at once per sweep.
+contact at once per sweep. A crowded step (strategies.py) hands it every solve, however small: a
+few dozen contacts in many colours cost ten times more by colour than at once.
 
 Balls are rows 0…N−1 of the velocity arrays; row N is the static world (planes), with zero inverse
 mass, so a sphere–plane contact is a sphere–sphere contact whose second body never moves.
@@ -115,14 +116,15 @@ def solve(
     iterations: int,
     jacobi_sweeps: int = JACOBI_SWEEPS,
     friction_every: int = JACOBI_FRICTION_EVERY,
+    jacobi_from: int = JACOBI_FROM,
 ) -> Impulses:
     """Projected Gauss–Seidel: drive every contact's normal speed to ≥ ``target`` with friction and
     rolling resistance; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates. From
-    JACOBI_FROM contacts on, ``jacobi_sweeps`` Jacobi sweeps stand for each iteration, and only every
+    ``jacobi_from`` contacts on, ``jacobi_sweeps`` Jacobi sweeps stand for each iteration, and only every
     ``friction_every``-th of them updates friction (see ``jacobi.solve``)."""
     if len(contacts) == 0:
         return imp
-    if len(contacts) >= JACOBI_FROM:
+    if len(contacts) >= jacobi_from:
         return jacobi.solve(contacts, v, w, target, imp, jacobi_sweeps * iterations, friction_every)
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.

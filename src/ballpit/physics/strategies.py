@@ -203,7 +203,7 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
         penetration.remove_penetration(model, state, c, batch)
     with prof.stage("impacts"):
         impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
-                       arrivals_only=True)  # fmt: skip
+                       arrivals_only=True, jacobi_from=0)  # fmt: skip
     free, ang = free_acceleration(state.body, step.forces)
     # The bounces turned some balls towards neighbours they were not closing on before: those pairs
     # join the speculative contacts, and bounce in turn if they now arrive.
@@ -220,11 +220,11 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
         # is caught between neighbours bouncing too, and the resting solve stops it.
         with prof.stage("impacts"):
             impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
-                           arrivals_only=True, seeds_among=new)  # fmt: skip
+                           arrivals_only=True, seeds_among=new, jacobi_from=0)  # fmt: skip
         free, ang = free_acceleration(state.body, step.forces)
     with prof.stage("resting solve"):
         push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, -allowance, step.warm,
-                                      step.events, now)  # fmt: skip
+                                      step.events, now, jacobi_from=0)  # fmt: skip
     lin = free if push is None else free + push.lin
     with prof.stage("pairs"):
         if pairs.escaped(model, state, lin, dt):
