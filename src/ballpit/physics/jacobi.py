@@ -35,7 +35,15 @@ class _Ends:
 
     def __init__(self, a: np.ndarray, b: np.ndarray, rows: int) -> None:
         self.k = len(a)
-        self.balls, self.ends = np.unique(np.concatenate((a, b)), return_inverse=True)
+        ab = np.concatenate((a, b))
+        rows_in_world = int(ab.max()) + 1
+        if len(ab) * 8 < rows_in_world:  # few contacts in a big world: sorting them is cheaper
+            self.balls, self.ends = np.unique(ab, return_inverse=True)
+        else:  # the same compact numbering (balls in increasing order) from a table over the world
+            present = np.zeros(rows_in_world, bool)
+            present[ab] = True
+            self.balls = np.flatnonzero(present)
+            self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
         self.share = np.bincount(self.ends, minlength=self.m).astype(float)
         # where each of the (rows, 2K) per-end entries lands in the flattened (rows, M) per-ball array
