@@ -29,7 +29,7 @@ BROAD_PHASE_REACH = 0.2
 # … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
 BROAD_PHASE_MARGIN = 0.1
 # Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
-ESCAPE_CHUNK = 4096
+ESCAPE_CHUNK = 8192
 
 
 @dataclass
