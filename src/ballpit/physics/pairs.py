@@ -46,10 +46,9 @@ class KeptPairs:
     plane: np.ndarray
     side: np.ndarray  # ±1: the side of the plane the ball is on
     counts: tuple[int, int]  # balls and planes in the world when the pairs were found
-    # lo, hi and centre as contiguous (3, N) columns for ``escaped``, made when first needed
-    _columns: tuple[np.ndarray, np.ndarray, np.ndarray] | None = field(
-        default=None, init=False, repr=False, compare=False
-    )
+    # lo, hi and centre as contiguous (3, N) columns for ``escaped``, made when first needed (``among``
+    # hands them on with the boxes)
+    _columns: tuple[np.ndarray, ...] | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.pair_i) + len(self.sphere)
@@ -222,9 +221,8 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
     counts = (model.spheres.count, model.planes.count)
-    kept = KeptPairs(*rows, reach, i, j, s, p, plane_sides(model, state, s, p), counts)
-    kept._columns = (lo, hi, centre)
-    return kept
+    sides = plane_sides(model, state, s, p)
+    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, _columns=(lo, hi, centre))
 
 
 def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray,
