@@ -37,6 +37,8 @@ def _overlap(lo: np.ndarray, hi: np.ndarray, i: np.ndarray, j: np.ndarray) -> np
     """Whether boxes i and j overlap, axis by axis on contiguous coordinates (several times faster
     than comparing gathered (K, 3) rows)."""
     ok = np.ones(len(i), bool)
+    if len(i) == 0:
+        return ok
     for lo_axis, hi_axis in zip(np.ascontiguousarray(lo.T), np.ascontiguousarray(hi.T), strict=True):
         ok &= np.take(lo_axis, i) <= np.take(hi_axis, j)
         ok &= np.take(lo_axis, j) <= np.take(hi_axis, i)
@@ -74,7 +76,8 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
         i, j = np.triu_indices(n, 1)
         hit = _overlap(lo, hi, i, j)
         return i[hit], j[hit]
-    extent = (hi - lo).max(axis=1)
+    # the largest side of each box, axis by axis on columns (a max is exact, in any order)
+    extent = np.maximum(np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1]), hi[:, 2] - lo[:, 2])
     # The smallest cell that still holds every box keeps the fewest boxes per cell to test: in a packed
     # pile, a cell of twice the median box would hold ~8× as many.
     cell = min(2.0 * float(np.median(extent)), float(extent.max()))
@@ -83,31 +86,18 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     pairs_i, pairs_j = [], []
 
     if len(small) > 1:
-        center = 0.5 * (lo[small] + hi[small])
+        center = 0.5 * (lo + hi) if len(small) == n else 0.5 * (lo[small] + hi[small])
         c = np.floor(center / cell).astype(np.int64)
-        c -= c.min(axis=0) - 1  # keep neighbour cells non-negative
-        dims = c.max(axis=0) + 2
+        # keep neighbour cells non-negative (column by column: a reduction down a (N, 3) array is slow)
+        c -= np.array([c[:, k].min() for k in range(3)]) - 1
+        dims = np.array([c[:, k].max() for k in range(3)]) + 2
         key = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
-        order = np.argsort(key, kind="stable")
         cells = int(np.prod(dims))
-        if cells <= DENSE_CELLS_PER_BALL * len(small):  # a table of every cell's first ball and count
-            per_cell = np.bincount(key, minlength=cells + 1)
-            first_in_cell = np.cumsum(per_cell) - per_cell
-        else:
-            sorted_key = key[order]
-        # every ball's own cell and its 13 forward neighbours at once
-        steps = (_OFFSETS[:, 0] * dims[1] + _OFFSETS[:, 1]) * dims[2] + _OFFSETS[:, 2]
-        neighbour = (key[None, :] + steps[:, None]).ravel()  # offset-major: own cells first
         if cells <= DENSE_CELLS_PER_BALL * len(small):
-            neighbour = np.minimum(neighbour, cells)  # past the last cell: the empty sentinel
-            start, count = np.take(first_in_cell, neighbour), np.take(per_cell, neighbour)
+            i, j = _dense_candidates(key, dims, cells)
         else:
-            start = np.searchsorted(sorted_key, neighbour, "left")
-            count = np.searchsorted(sorted_key, neighbour, "right") - start
-        owner, pos = _ranges(start, count)
-        i, j = owner % len(small), np.take(order, pos)
-        keep = (owner >= len(small)) | (i < j)  # own cell: each pair once, never a ball with itself
-        i, j = np.take(small, i[keep]), np.take(small, j[keep])
+            i, j = _sparse_candidates(key, dims)
+        i, j = np.take(small, i), np.take(small, j)
         hit = _overlap(lo, hi, i, j)
         pairs_i.append(i[hit])
         pairs_j.append(j[hit])
@@ -128,6 +118,77 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return lo_ij[order], hi_ij[order]
 
 
+def _neighbour_steps(dims: np.ndarray) -> np.ndarray:
+    """The key differences of the _OFFSETS for a grid of ``dims`` cells."""
+    return (_OFFSETS[:, 0] * dims[1] + _OFFSETS[:, 1]) * dims[2] + _OFFSETS[:, 2]
+
+
+def _dense_candidates(key: np.ndarray, dims: np.ndarray, cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate pairs (places in ``key``) from a table of every cell's first ball and count: each ball
+    with the later balls of its own cell and every ball of its 13 forward neighbours."""
+    n = len(key)
+    order = np.argsort(key, kind="stable")
+    per_cell = np.bincount(key, minlength=cells + 1)
+    first_in_cell = np.cumsum(per_cell) - per_cell
+    # every ball's own cell and its 13 forward neighbours at once
+    neighbour = (key[None, :] + _neighbour_steps(dims)[:, None]).ravel()  # offset-major: own cells first
+    neighbour = np.minimum(neighbour, cells)  # past the last cell: the empty sentinel
+    start, count = np.take(first_in_cell, neighbour), np.take(per_cell, neighbour)
+    owner, pos = _ranges(start, count)
+    i, j = owner % n, np.take(order, pos)
+    keep = (owner >= n) | (i < j)  # own cell: each pair once, never a ball with itself
+    return i[keep], j[keep]
+
+
+def _sparse_candidates(key: np.ndarray, dims: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The same candidate pairs as ``_dense_candidates`` (places in ``key``) when the grid has far more
+    cells than balls (balls spread apart), found from the occupied cells alone.
+
+    A forward neighbour is the next cell along z, or one of three cells (z − 1 … z + 1) in one of four
+    forward rows (a row: the cells sharing x and y). Rows are matched first, so only the cells of rows
+    with an occupied neighbour row are looked up: balls far apart cost a sort and a few passes.
+    """
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    n = len(key)
+    starts = np.flatnonzero(np.r_[True, sorted_key[1:] != sorted_key[:-1]])
+    cell_key = sorted_key[starts]  # the occupied cells in key order, their balls at places starts…ends
+    ends = np.r_[starts[1:], n]
+    row = cell_key // dims[2]
+    row_starts = np.flatnonzero(np.r_[True, row[1:] != row[:-1]])
+    row_key = row[row_starts]  # the occupied rows, their cells at row_starts…row_ends
+    row_ends = np.r_[row_starts[1:], len(cell_key)]
+    # own cell: every place p with the later places of its cell (stable sort: later is larger)
+    place = np.arange(n)
+    cell_end = np.repeat(ends, ends - starts)
+    first, second = _ranges(place + 1, cell_end - place - 1)
+    pi, pj = [place[first]], [second]
+    # the next cell along z
+    a = np.flatnonzero(cell_key[1:] == cell_key[:-1] + 1)
+    cell_a, cell_b = [a], [a + 1]
+    # cells z − 1 … z + 1 of each forward row (dx, dy) = (0, 1), (1, −1), (1, 0), (1, 1)
+    for dx, dy in ((0, 1), (1, -1), (1, 0), (1, 1)):
+        delta = dx * dims[1] + dy
+        at = np.minimum(np.searchsorted(row_key, row_key + delta), len(row_key) - 1)
+        rows_a = np.flatnonzero(row_key[at] == row_key + delta)
+        if rows_a.size == 0:
+            continue
+        _, ca = _ranges(row_starts[rows_a], row_ends[rows_a] - row_starts[rows_a])
+        target = cell_key[ca] + delta * dims[2]
+        lo_cell = np.searchsorted(cell_key, target - 1, "left")
+        hi_cell = np.searchsorted(cell_key, target + 1, "right")
+        which, cb = _ranges(lo_cell, hi_cell - lo_cell)
+        cell_a.append(ca[which])
+        cell_b.append(cb)
+    cell_a, cell_b = np.concatenate(cell_a), np.concatenate(cell_b)
+    # every ball of cell a with every ball of cell b
+    pair, pa = _ranges(starts[cell_a], ends[cell_a] - starts[cell_a])
+    which, pb = _ranges(starts[cell_b][pair], (ends[cell_b] - starts[cell_b])[pair])
+    pi.append(pa[which])
+    pj.append(pb)
+    return np.take(order, np.concatenate(pi)), np.take(order, np.concatenate(pj))
+
+
 def sphere_plane_pairs(
     lo: np.ndarray,
     hi: np.ndarray,
@@ -143,6 +204,9 @@ def sphere_plane_pairs(
     ``sweep(p, d)``, when given, is how far a point of plane ``p`` at distance ``d`` from its centre
     may move (a moving plane); a box that close counts too.
     """
+    if len(center) == 0:  # no planes
+        empty = np.zeros(0, np.intp)
+        return empty, empty
     box_center = 0.5 * (lo + hi)
     box_radius = 0.5 * np.linalg.norm(hi - lo, axis=1)
     spheres, planes = [], []

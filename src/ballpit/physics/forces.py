@@ -1,11 +1,14 @@
 """Named force terms. Each adds its linear and angular acceleration for a trial state.
 
 The integrators call every term at every stage, so velocity-dependent forces such as drag are
-evaluated where a multi-stage method needs them, not frozen at the start of the step.
+evaluated where a multi-stage method needs them, not frozen at the start of the step. Terms that do not
+depend on the state at all also have ``constant``, so an integrator can add them up once per step
+(``constant_acceleration``) instead of once per stage.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
@@ -27,6 +30,10 @@ class Gravity:
 
     def add(self, state: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> None:
         lin += self.g
+
+    def constant(self, lin: np.ndarray, ang: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``add`` for any state, on arrays of any broadcastable shape (returns the sums)."""
+        return lin + self.g, ang
 
 
 class LinearDrag:
@@ -60,11 +67,34 @@ class ConstantPerBall:
         lin += self.lin
         ang += self.ang
 
+    def constant(self, lin: np.ndarray, ang: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``add`` for any state, on arrays of any broadcastable shape (returns the sums)."""
+        return lin + self.lin, ang + self.ang
+
 
 def free_acceleration(body: np.ndarray, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
     """Linear and angular acceleration of each ball from the force terms alone, at state ``body``."""
+    constant = constant_acceleration(forces)
+    if constant is not None:  # the same sums, made once (or once per ball) and repeated
+        return tuple(np.tile(a, (len(body), 1)) if len(a) == 1 else a for a in constant)
     lin = np.zeros((len(body), 3))
     ang = np.zeros((len(body), 3))
     for term in forces:
         term.add(body, lin, ang)
+    return lin, ang
+
+
+def constant_acceleration(forces: Sequence[ForceTerm]) -> tuple[np.ndarray, np.ndarray] | None:
+    """The linear and angular acceleration the terms add up to when none depends on the state (else
+    None): (1, 3) rows, or (N, 3) once a per-ball term joins.
+
+    The sums are the ones ``add`` makes at every stage, in the same order from the same zero, so the
+    values are bit for bit those a stage would see; only the broadcasting differs.
+    """
+    lin, ang = np.zeros((1, 3)), np.zeros((1, 3))
+    for term in forces:
+        constant = getattr(term, "constant", None)
+        if constant is None:  # depends on the state (drag) or is not one of ours
+            return None
+        lin, ang = constant(lin, ang)
     return lin, ang

@@ -10,7 +10,7 @@ found again every step, from the kept boxes and the plane's sweep over the step.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -28,6 +28,8 @@ BROAD_PHASE_STEPS = 4
 BROAD_PHASE_REACH = 0.2
 # … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
 BROAD_PHASE_MARGIN = 0.1
+# Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
+ESCAPE_CHUNK = 8192
 
 
 @dataclass
@@ -44,6 +46,9 @@ class KeptPairs:
     plane: np.ndarray
     side: np.ndarray  # ±1: the side of the plane the ball is on
     counts: tuple[int, int]  # balls and planes in the world when the pairs were found
+    # lo, hi and centre as contiguous (3, N) columns for ``escaped``, made when first needed (``among``
+    # hands them on with the boxes)
+    _columns: tuple[np.ndarray, ...] | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.pair_i) + len(self.sphere)
@@ -64,20 +69,70 @@ class KeptPairs:
         )
 
     def escaped(self, model: Model, state: State, accel: np.ndarray, h: float) -> bool:
-        """True when some ball's path for the next ``h`` leaves the box or sphere it was paired from."""
-        body, radius = state.body, model.spheres.radius
-        x = body[:, X]
-        path = model.integrator
-        end = path.path_end(x, body[:, V], accel, h)
-        pad = radius + path.sag(accel, h)
-        box_pad = pad[:, None]
-        if np.any(np.minimum(x, end) - box_pad < self.lo) or np.any(np.maximum(x, end) + box_pad > self.hi):
-            return True
-        # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
-        farthest = np.maximum(
-            np.linalg.norm(x - self.centre, axis=1), np.linalg.norm(end - self.centre, axis=1)
-        )
-        return bool(np.any(farthest + pad > self.reach))
+        """True when some ball's path for the next ``h`` leaves the box or sphere it was paired from.
+
+        Each value compared is formed by the same operations as ``Integrator.path_end``, ``sag`` and
+        ``np.linalg.norm`` over rows (which sums the three squares in order), but on contiguous columns,
+        ESCAPE_CHUNK balls at a time: the scratch stays in the cache, and the test stops at the first
+        chunk with an escape.
+        """
+        body, radius, path = state.body, model.spheres.radius, model.integrator
+        if self._columns is None:  # the boxes and spheres as contiguous (3, N) columns, made once
+            self._columns = tuple(np.ascontiguousarray(a.T) for a in (self.lo, self.hi, self.centre))
+        lo, hi, centre = self._columns
+        n = len(body)
+        lift, pad = None, radius  # ½h²·a along the path, and radius + ⅛h²·|a| (sag is 0.0 if straight)
+        if path.quadratic_path and n:
+            if (accel == accel[0]).all():
+                # One acceleration for all (gravity, drag-free flight): a single column. A row that
+                # differs from the first only in the sign of a zero moves ``end`` by a signed zero at
+                # most, which none of the comparisons below can tell apart.
+                accel = accel[:1]
+            a = accel.T
+            lift = a * (0.5 * h * h)
+            pad = radius + _norm(a, np.empty(a.shape), np.empty(a.shape[1])) * (0.125 * h * h)
+        shared = lift is not None and lift.shape[1] == 1
+        size = min(n, ESCAPE_CHUNK)
+        x, end, d, e = (np.empty((3, size)) for _ in range(4))
+        far, tmp = np.empty(size), np.empty(size)
+        for start in range(0, n, ESCAPE_CHUNK):
+            rows = slice(start, start + ESCAPE_CHUNK)
+            m = min(ESCAPE_CHUNK, n - start)
+            xs, ends, ds, es, fars, tmps = x[:, :m], end[:, :m], d[:, :m], e[:, :m], far[:m], tmp[:m]
+            pads = pad[rows]
+            np.copyto(xs, body[rows, X].T)
+            np.multiply(body[rows, V].T, h, out=ends)
+            ends += xs  # x + v·h
+            if lift is not None:
+                ends += lift if shared else lift[:, rows]  # … + ½h²·a
+            # the box around the chord, grown by pad, inside the kept box
+            np.minimum(xs, ends, out=ds)
+            ds -= pads
+            if np.any(ds < lo[:, rows]):
+                return True
+            np.maximum(xs, ends, out=ds)
+            ds += pads
+            if np.any(ds > hi[:, rows]):
+                return True
+            # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
+            np.subtract(xs, centre[:, rows], out=ds)
+            _norm(ds, es, fars)
+            np.subtract(ends, centre[:, rows], out=ds)
+            _norm(ds, es, tmps)
+            np.maximum(fars, tmps, out=fars)
+            fars += pads
+            if np.any(fars > self.reach[rows]):
+                return True
+        return False
+
+
+def _norm(a: np.ndarray, scratch: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """The length of each column of ``a`` (3, m), as ``np.linalg.norm(rows, axis=1)`` gives it:
+    sqrt((x² + y²) + z²), summed in that order."""
+    np.multiply(a, a, out=scratch)
+    np.add(scratch[0], scratch[1], out=out)
+    out += scratch[2]
+    return np.sqrt(out, out=out)
 
 
 class PairCache:
@@ -124,27 +179,50 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     up to ``ahead`` seconds of free flight under ``free`` for balls slow enough to travel less than
     BROAD_PHASE_REACH radii in that time: slow balls keep their pairs for several steps while fast
     ones do not drag big boxes through a crowd.
+
+    The arithmetic is that of ``Integrator.path_end`` and ``np.linalg.norm`` over rows, done on
+    contiguous (3, N) columns (the norm sums its three squares in order, as ``_norm`` does).
     """
     body, radius = state.body, model.spheres.radius
     path: Integrator = model.integrator
-    x, v = body[:, X], body[:, V]
-    speed = np.linalg.norm(v, axis=1)
+    n = len(body)
+    x, v = np.ascontiguousarray(body[:, X].T), np.ascontiguousarray(body[:, V].T)
+    accel_t, free_t = accel.T, free.T
+    scratch = np.empty((3, n))
+    speed = _norm(v, scratch, np.empty(n))
     horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, 1e-12), h, max(h, ahead))
-    now = path.path_end(x, v, accel, h)
-    later = path.path_end(x, v, free, horizon[:, None])
+    now = v * h
+    now += x
+    later = v * horizon
+    later += x
+    if path.quadratic_path:
+        now += accel_t * (0.5 * h * h)
+        bend = 0.5 * horizon
+        bend *= horizon
+        later += free_t * bend
     # a parabola strays at most ⅛·|a|·t² from its chord
-    sag = 0.125 * (np.linalg.norm(accel, axis=1) * h * h + np.linalg.norm(free, axis=1) * horizon**2)
-    pad = (radius + sag + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP)[:, None]
-    lo = np.minimum(np.minimum(x, now), later)
-    hi = np.maximum(np.maximum(x, now), later)
-    centre = 0.5 * (lo + hi)
-    reach = 0.5 * np.linalg.norm(hi - lo, axis=1) + pad[:, 0]
+    free_norm = _norm(free_t, scratch, np.empty(n))
+    accel_norm = free_norm if accel is free else _norm(accel_t, scratch, np.empty(n))
+    sag = 0.125 * (accel_norm * h * h + free_norm * horizon**2)
+    pad = radius + sag + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP
+    lo = np.minimum(x, now)
+    np.minimum(lo, later, out=lo)
+    hi = np.maximum(x, now, out=now)
+    np.maximum(hi, later, out=hi)
+    centre = lo + hi
+    centre *= 0.5
+    np.subtract(hi, lo, out=scratch)
+    reach = _norm(scratch, scratch, np.empty(n))
+    reach *= 0.5
+    reach += pad
     lo -= pad
     hi += pad
-    i, j = broadphase.within_reach(*broadphase.sphere_pairs(lo, hi), centre, reach)
-    s, p = plane_pairs(model, state, lo, hi, ahead)
+    rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), as kept
+    i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
+    s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
     counts = (model.spheres.count, model.planes.count)
-    return KeptPairs(lo, hi, centre, reach, i, j, s, p, plane_sides(model, state, s, p), counts)
+    sides = plane_sides(model, state, s, p)
+    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, _columns=(lo, hi, centre))
 
 
 def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray,
