@@ -75,6 +75,8 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndar
     impact uses), touching ones included.
     """
     dt, model = step.dt, step.model
+    if len(c) == 0:  # nothing near anything (free flight): nothing can meet
+        return None
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
