@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from . import moving_planes
-from .contacts import SPHERE_PLANE, ContactPoints
+from .contacts import SPHERE_PLANE, ContactPoints, take_indices
 from .model import Model
 from .state import State
 
@@ -56,7 +56,8 @@ class ContactRows:
     def subset(self, mask: np.ndarray) -> ContactRows:
         """The contacts where ``mask`` holds."""
         kept = ("moving", "static")
-        fields = {k: v[mask] for k, v in vars(self).items() if k not in (*kept, "colours")}
+        idx = take_indices(mask)
+        fields = {k: np.take(v, idx, axis=0) for k, v in vars(self).items() if k not in (*kept, "colours")}
         return ContactRows(**fields, moving=self.moving, static=self.static)
 
 
