@@ -48,7 +48,7 @@ def sphere_plane(
     crossed the face (which continuous detection prevents, but an edited scene can cause) is pushed back
     to the side it came from instead of through.
     """
-    p = x[sphere]
+    p = np.take(x, sphere, axis=0)  # rows by index: several times faster than x[sphere]
     point = closest_point_on_planes(p, plane, center, axis_u, axis_v, half_size)
     delta = p - point
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
@@ -67,8 +67,8 @@ def sphere_sphere(
     x: np.ndarray, radius: np.ndarray, i: np.ndarray, j: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap, unit normal (from j towards i) and contact point (middle of the gap) for each pair."""
-    xj = x[j]
-    delta = x[i] - xj
+    xj = np.take(x, j, axis=0)  # rows by index: several times faster than x[j]
+    delta = np.take(x, i, axis=0) - xj
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
     coincident = dist <= 1e-12
     normal = delta / np.maximum(dist, 1e-12)[:, None]

@@ -40,7 +40,8 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
     ra, rb = rows.arm_a, rows.arm_b
-    rel = v[c.a] + np.cross(w[c.a], ra) - v[c.b] - np.cross(w[c.b], rb)
+    va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
+    rel = va + np.cross(wa, ra) - vb - np.cross(wb, rb)
     if rows.moving:  # relative to a moving plane's surface
         rel -= rows.surface
     vn = np.einsum("ij,ij->i", rel, c.normal)

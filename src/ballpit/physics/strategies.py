@@ -101,7 +101,8 @@ def _relative_motion(step: Step, c: ContactPoints, accel: np.ndarray) -> tuple[n
     """Each pair's relative velocity (against a moving plane's surface) and acceleration."""
     model = step.model
     v, acc = with_static(step.state.body[:, V]), with_static(accel)
-    dv, da = v[c.a] - v[c.b], acc[c.a] - acc[c.b]
+    dv = np.take(v, c.a, axis=0) - np.take(v, c.b, axis=0)  # rows by index: faster than v[c.a]
+    da = np.take(acc, c.a, axis=0) - np.take(acc, c.b, axis=0)
     if model.moving_planes():  # relative to a moving plane's surface under the contact point
         on = c.kind == SPHERE_PLANE
         dv[on] -= moving_planes.surface_velocity(model, step.state, c.other[on], c.point[on])
