@@ -124,3 +124,25 @@ def test_mass_splitting_never_pushes_a_ball_faster_than_anything_arrived():
         jacobi.solve(rows, v, w, np.zeros(k + 1), imp, 1)
         assert np.linalg.norm(v, axis=1).max() <= u + 1e-12
     assert imp.normal.min() > 0.0  # every contact took part
+
+
+@pytest.mark.parametrize("friction_every", [1, 4])
+def test_friction_in_some_sweeps_only_gives_sliding_and_sticking_balls_their_closed_forms(friction_every):
+    """Balls on the floor after a step of free fall, moving sideways at u. Fast ones slide: friction
+    takes μ·g·dt off u and the floor holds m·g·dt. Slow ones stick: they leave rolling, at 5/7·u with
+    ω = −v/R. Friction updated in only every fourth sweep must reach the same answers."""
+    n, mu = 70, 0.5
+    u = np.where(np.arange(n) % 2 == 0, 1.0, 0.01)  # 2/7·u against μ·g·dt = 0.0204: slide, then stick
+    rows = equal_balls(
+        np.arange(n), np.full(n, n), np.tile([0.0, 1.0, 0.0], (n, 1)), friction=mu, rolling=0.0
+    )
+    v = np.zeros((n + 1, 3))
+    v[:n, 0], v[:n, 1] = u, -G * DT
+    w = np.zeros((n + 1, 3))
+    imp = jacobi.solve(rows, v, w, np.zeros(n), Impulses.zeros(n), 8, friction_every)
+    slides = u > 0.5
+    assert imp.normal == pytest.approx(np.full(n, M * G * DT), rel=1e-12)
+    assert np.abs(v[:n, 1]).max() < 1e-12
+    assert v[:n, 0][slides] == pytest.approx(u[slides] - mu * G * DT, rel=1e-12)
+    assert v[:n, 0][~slides] == pytest.approx(5 / 7 * u[~slides], rel=1e-12)
+    assert w[:n, 2][~slides] == pytest.approx(-5 / 7 * u[~slides] / R, rel=1e-12)
