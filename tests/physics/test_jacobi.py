@@ -1,5 +1,6 @@
 """The all-contacts-at-once solve (Jacobi with mass splitting) reaches the same answers the
-colour-by-colour solve does: checked against a resting column's closed form."""
+colour-by-colour solve does: checked against the closed forms of a resting column and of balls that
+slide or stick on the floor."""
 
 import numpy as np
 import pytest
