@@ -36,7 +36,7 @@ class _Ends:
     def __init__(self, a: np.ndarray, b: np.ndarray, rows: int) -> None:
         self.k = len(a)
         ab = np.concatenate((a, b))
-        rows_in_world = int(ab.max()) + 1
+        rows_in_world = int(ab.max(initial=-1)) + 1
         if len(ab) * 8 < rows_in_world:  # few contacts in a big world: sorting them is cheaper
             self.balls, self.ends = np.unique(ab, return_inverse=True)
         else:  # the same compact numbering (balls in increasing order) from a table over the world

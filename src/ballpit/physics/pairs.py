@@ -71,27 +71,24 @@ class KeptPairs:
     def escaped(self, model: Model, state: State, accel: np.ndarray, h: float) -> bool:
         """True when some ball's path for the next ``h`` leaves the box or sphere it was paired from.
 
-        Each value compared is formed by the same operations as ``Integrator.path_end``, ``sag`` and
-        ``np.linalg.norm`` over rows (which sums the three squares in order), but on contiguous columns,
-        ESCAPE_CHUNK balls at a time: the scratch stays in the cache, and the test stops at the first
-        chunk with an escape.
+        The path's pad and bend come from the integrator (``sag``, ``path_acceleration``); each value
+        compared is formed by the same operations as ``Integrator.path_end`` and ``np.linalg.norm`` over
+        rows (which sums the three squares in order), but on contiguous columns, ESCAPE_CHUNK balls at a
+        time: the scratch stays in the cache, and the test stops at the first chunk with an escape.
         """
         body, radius, path = state.body, model.spheres.radius, model.integrator
         if self._columns is None:  # the boxes and spheres as contiguous (3, N) columns, made once
             self._columns = tuple(np.ascontiguousarray(a.T) for a in (self.lo, self.hi, self.centre))
         lo, hi, centre = self._columns
         n = len(body)
-        lift, pad = None, radius  # ½h²·a along the path, and radius + ⅛h²·|a| (sag is 0.0 if straight)
-        if path.quadratic_path and n:
-            if (accel == accel[0]).all():
-                # One acceleration for all (gravity, drag-free flight): a single column. A row that
-                # differs from the first only in the sign of a zero moves ``end`` by a signed zero at
-                # most, which none of the comparisons below can tell apart.
-                accel = accel[:1]
-            a = accel.T
-            lift = a * (0.5 * h * h)
-            pad = radius + _norm(a, np.empty(a.shape), np.empty(a.shape[1])) * (0.125 * h * h)
-        shared = lift is not None and lift.shape[1] == 1
+        if n and (accel == accel[0]).all():
+            # One acceleration for all (gravity, drag-free flight): a single column. A row that differs
+            # from the first only in the sign of a zero moves ``end`` by a signed zero at most, which
+            # none of the comparisons below can tell apart.
+            accel = accel[:1]
+        pad = radius + path.sag(accel, h)
+        lift = path.path_acceleration(accel).T * (0.5 * h * h)  # ½h²·a along the path (0 if straight)
+        shared = lift.shape[1] == 1
         size = min(n, ESCAPE_CHUNK)
         x, end, d, e = (np.empty((3, size)) for _ in range(4))
         far, tmp = np.empty(size), np.empty(size)
@@ -103,8 +100,7 @@ class KeptPairs:
             np.copyto(xs, body[rows, X].T)
             np.multiply(body[rows, V].T, h, out=ends)
             ends += xs  # x + v·h
-            if lift is not None:
-                ends += lift if shared else lift[:, rows]  # … + ½h²·a
+            ends += lift if shared else lift[:, rows]  # … + ½h²·a
             # the box around the chord, grown by pad, inside the kept box
             np.minimum(xs, ends, out=ds)
             ds -= pads
@@ -180,8 +176,8 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     BROAD_PHASE_REACH radii in that time: slow balls keep their pairs for several steps while fast
     ones do not drag big boxes through a crowd.
 
-    The arithmetic is that of ``Integrator.path_end`` and ``np.linalg.norm`` over rows, done on
-    contiguous (3, N) columns (the norm sums its three squares in order, as ``_norm`` does).
+    The paths are ``Integrator.path_end`` on contiguous (3, N) columns, and their lengths are
+    ``np.linalg.norm`` over rows as ``_norm`` forms it on columns (its three squares summed in order).
     """
     body, radius = state.body, model.spheres.radius
     path: Integrator = model.integrator
@@ -191,15 +187,8 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     scratch = np.empty((3, n))
     speed = _norm(v, scratch, np.empty(n))
     horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, 1e-12), h, max(h, ahead))
-    now = v * h
-    now += x
-    later = v * horizon
-    later += x
-    if path.quadratic_path:
-        now += accel_t * (0.5 * h * h)
-        bend = 0.5 * horizon
-        bend *= horizon
-        later += free_t * bend
+    now = path.path_end(x, v, accel_t, h)
+    later = path.path_end(x, v, free_t, horizon)
     # a parabola strays at most ⅛·|a|·t² from its chord
     free_norm = _norm(free_t, scratch, np.empty(n))
     accel_norm = free_norm if accel is free else _norm(accel_t, scratch, np.empty(n))
