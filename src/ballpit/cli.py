@@ -19,12 +19,15 @@ from typing import TYPE_CHECKING, NoReturn
 from . import __version__
 from .allocator import keep_freed_memory
 from .physics import INTEGRATOR_NAMES
+from .physics.integrators import INTEGRATORS
 
 if TYPE_CHECKING:
     from .physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+_LABELS = [integrator.label for integrator in INTEGRATORS.values()]
+_INTEGRATOR_LABELS = ", ".join(_LABELS[:-1]) + " and " + _LABELS[-1]  # "Euler, RK2, RK4 and ..."
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -181,9 +184,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "compare",
-        help="run a scene under Euler, RK2 and RK4 and compare energy drift and end positions",
-        description="Run the scene under Euler, RK2 and RK4 (each from its initial state) and RK4 at a "
-        "quarter of the step as a reference; print each one's total-energy drift and how far its balls "
+        help=f"run a scene under {_INTEGRATOR_LABELS} and compare energy drift and end positions",
+        description=f"Run the scene under {_INTEGRATOR_LABELS} (each from its initial state) and RK4 at "
+        "a quarter of the step as a reference; print each one's total-energy drift and how far its balls "
         "end from the reference's.",
     )
     _add_run_arguments(p)
