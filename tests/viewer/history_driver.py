@@ -8,7 +8,6 @@ from xdotool. The last stdout line is ``RESULT <json>``.
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 from pathlib import Path
 
@@ -218,14 +217,5 @@ def replay(workdir: Path) -> dict:
 SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay)}
 
 
-def main() -> None:
-    scenario, workdir = sys.argv[1], Path(sys.argv[2])
-    result = SCENARIOS[scenario](workdir)
-    for viewer in wd.OPENED:
-        viewer.close()
-        viewer.pump()
-    print("RESULT " + json.dumps(result), flush=True)
-
-
 if __name__ == "__main__":
-    main()
+    wd.main(SCENARIOS)

@@ -70,7 +70,7 @@ def test_each_registered_integrator_has_its_key_on_both_rows_and_in_the_help(int
     for name in (f"_{integrator.key}", f"NUM_{integrator.key}"):
         assert controls.INTEGRATOR_ACTIONS[action_for_key(name)] == integrator.name
     keys, what = next(row for row in controls.HELP if "faster" in row[1])
-    assert integrator.key in keys.split(" / ") or f"{integrator.key}," in keys
+    assert integrator.key in keys.replace(",", "/").split("/")
     assert integrator.label in what
 
 
@@ -115,7 +115,7 @@ def test_escape_releases_a_captured_mouse_and_quits_only_when_pressed_again():
 
 def test_help_lists_every_control_of_the_design_table():
     keys = " ".join(k for k, _ in controls.HELP)
-    for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1 / 2 / 3", "+ / −", "W A S D", "Q E",
+    for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1/2/3/4", "+ / −", "W A S D", "Q E",
                   "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12", "←", "Shift+←", "G", "P"):  # fmt: skip
         assert label in keys, label
     assert "scroll" in " ".join(w for _, w in controls.HELP)

@@ -16,8 +16,12 @@ from .conftest import REPO, run_driver, subprocess_env
 DRIVER = Path(__file__).with_name("history_driver.py")
 
 
+# the scenarios of history_driver.py that take no extra arguments, run in one window process
+BATCH = ("history_keys", "ghosts_and_plot")
+
+
 def run_scenario(display: str, name: str, workdir: Path, *extra: str) -> dict:
-    return run_driver(DRIVER, display, name, workdir, *extra, timeout=300)
+    return run_driver(DRIVER, display, name, workdir, *extra, timeout=300, batch=() if extra else BATCH)
 
 
 def test_arrow_keys_and_a_dragged_timeline_move_through_the_history_exactly(xvfb, tmp_path):

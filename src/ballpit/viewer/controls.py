@@ -132,8 +132,8 @@ HELP: tuple[tuple[str, str], ...] = (
     ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
     ("R / Ctrl+R or F5", "reset (X drops again) / reload (also on save)"),
     (
-        " / ".join(i.key for i in INTEGRATORS.values()) + ", + / −",
-        " / ".join(i.label for i in INTEGRATORS.values()) + "; faster / slower time",
+        "/".join(i.key for i in INTEGRATORS.values()) + ", + / −",
+        "/".join(i.label for i in INTEGRATORS.values()) + "; faster/slower time",
     ),
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
