@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import os
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +25,7 @@ from .bouncing_box import (
     euler_gain_per_step_law,
     write_scene,
 )
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 FLIGHTS = 3
@@ -34,13 +34,7 @@ STEPS = round(DURATION / DT)
 
 
 def ballpit(*args: str | Path, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "ballpit", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=300,
-    )
+    return run_in_process(*args, cwd=cwd)
 
 
 def parse_table(stdout: str) -> dict[str, dict[str, float | str]]:

@@ -5,8 +5,6 @@ The reference is computed here by stepping the World directly, with nothing stre
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import tracemalloc
 from pathlib import Path
 
@@ -17,6 +15,8 @@ from ballpit import cli, writers
 from ballpit.physics import Contacts
 from ballpit.scene import read_scene
 from ballpit.simulate import step_plan
+
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SLOPES = ROOT / "scenes" / "slopes.toml"
@@ -120,13 +120,7 @@ def assert_npz_equals(path: Path, columns: dict, names: list[str]) -> None:
 
 
 def simulate(*args: str | Path) -> None:
-    r = subprocess.run(
-        [sys.executable, "-m", "ballpit", "simulate", *map(str, args), "-q"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-    )
+    r = run_in_process("simulate", *args, "-q", cwd=ROOT)
     assert r.returncode == 0, r.stderr
 
 
