@@ -102,6 +102,7 @@ def test_cradle_passes_momentum_down_the_line(tmp_path):
     assert (kinds == "sphere-sphere").sum() >= 5
 
 
+@pytest.mark.slow
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):
     """The see-saw demo, judged from ``ballpit simulate`` output: the balls land on the plank, roll
     left (downhill), turn back as it tips over, and leave its right end for the floor."""

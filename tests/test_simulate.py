@@ -91,6 +91,7 @@ def read_profile(stdout: str) -> tuple[dict[str, float], str]:
     return ms, counts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("scene", "crowded"), [("slopes", False), ("pile", True)])
 def test_profile_prints_the_time_of_every_stage_and_the_counts_per_step(scene, crowded):
     from ballpit.physics.profile import STAGES

@@ -142,6 +142,7 @@ def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["e.csv", "e.npz", "t.csv", "t.npz"]
 
 
+@pytest.mark.slow
 def test_many_small_chunks_give_the_same_files(tmp_path, monkeypatch, slopes_reference):
     """Chunks of 7 rows: trajectory records and step contacts are split across many chunks."""
     monkeypatch.setattr(writers, "_CHUNK_ROWS", 7)
@@ -179,6 +180,7 @@ def peak_bytes(argv: list[str]) -> int:
         tracemalloc.stop()
 
 
+@pytest.mark.slow
 def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
     """2 s of 1,024 balls writes about 124 MB as .npz; held in memory, the peak grew by 140 MB.
 
@@ -198,6 +200,7 @@ def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
     assert peaks["2"] < 80e6, peaks
 
 
+@pytest.mark.slow
 def test_events_default_to_impacts_the_first_step_of_each_contact(tmp_path):
     """The slopes demo over 5 s: 1,710 contact rows, of which 47 are impacts (the bounces, the
     two mid-air collisions, the landings); the rest are balls resting or rolling on."""

@@ -165,6 +165,7 @@ def test_one_grid_over_the_cap(tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_forty_thousand_sphere_tables_check_in_linear_time(tmp_path):
     # Re-adding every earlier block for each new sphere made this take 37 s; linear it takes a few.
     text = "".join(f"[[sphere]]\nposition = [{2 * k}, 1, 0]\n" for k in range(40_000))
