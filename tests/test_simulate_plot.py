@@ -84,6 +84,7 @@ def test_bad_plot_path_is_one_line_and_nothing_runs(tmp_path, plot, fragment):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["box.toml"]
 
 
+@pytest.mark.slow
 def test_interrupted_run_leaves_no_plot(tmp_path):
     scene = write_scene(tmp_path, dt=1e-4)
     png = tmp_path / "energy.png"

@@ -39,7 +39,7 @@ def test_bounce_apex_is_e_squared_h_then_e_to_the_fourth_h(integrator, rate):
 
 
 @pytest.mark.parametrize("integrator", INTEGRATOR_NAMES)
-@pytest.mark.parametrize("rate", [60, 240])
+@pytest.mark.parametrize("rate", [60, pytest.param(240, marks=pytest.mark.slow)])
 def test_a_bouncing_ball_comes_to_rest_with_every_integrator(integrator, rate):
     world = ballpit.World(integrator=integrator)
     world.add_plane()  # default restitution 0.8
