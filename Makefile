@@ -1,9 +1,10 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
+# `make check` is the inner loop: lint, format and the tests marked neither slow nor window (< 1 min).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 
-.PHONY: demo test lint format bench clean
+.PHONY: demo check test lint format bench clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -14,6 +15,11 @@ $(VENV)/.installed: pyproject.toml
 # With no display the viewer prints how to render offscreen instead; that is not a failure here.
 demo: $(VENV)/.installed
 	@$(VENV)/bin/ballpit || { status=$$?; [ -z "$$DISPLAY" ] && [ $$status -eq 1 ] || exit $$status; }
+
+check: $(VENV)/.installed
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+	$(PY) -m pytest -q -m "not slow and not window"
 
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

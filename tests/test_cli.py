@@ -1,4 +1,8 @@
-"""The real command line in a subprocess: exit codes, one-line errors, output files and their columns."""
+"""The command line: exit codes, one-line errors, output files and their columns.
+
+Run in this process (``cli_runner.py``) except where the process itself is under test: signals, file
+size limits and the console script start a real ``python -m ballpit``.
+"""
 
 from __future__ import annotations
 
@@ -14,19 +18,11 @@ import pytest
 
 from ballpit.scene import load_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+from .cli_runner import ROOT
+from .cli_runner import run_in_process as ballpit
+
 TRAJECTORY_HEADER = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw"
 EVENTS_HEADER = "time,kind,a,b,x,y,z,nx,ny,nz,impulse"
-
-
-def ballpit(*args: str | Path, cwd: Path = ROOT, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "ballpit", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=timeout,
-    )
 
 
 def assert_user_error(r: subprocess.CompletedProcess, *expected: str) -> str:
@@ -290,18 +286,23 @@ def interrupt_while_writing(args: list, folder: Path) -> tuple[int, str]:
         [sys.executable, "-m", "ballpit", *map(str, args)], cwd=ROOT,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
-    deadline = time.monotonic() + 60
-    while not any(p.name.endswith(".partial") for p in folder.iterdir()) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.5)  # now inside the stepping loop
-    proc.send_signal(signal.SIGINT)
-    _, stderr = proc.communicate(timeout=60)
+    try:
+        deadline = time.monotonic() + 60
+        while not any(p.name.endswith(".partial") for p in folder.iterdir()) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.5)  # now inside the stepping loop
+        proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        proc.kill()  # a run that outlives a failed test must not keep stepping (no-op once it has exited)
+        proc.wait()
     return proc.returncode, stderr
 
 
+@pytest.mark.slow
 def test_interrupt_leaves_no_partial_file(tmp_path):
     out, ev = tmp_path / "t.csv", tmp_path / "e.csv"
-    args = ["simulate", "scenes/pile10k.toml", "--duration", "60", "--out", out, "--events", ev]
+    args = ["simulate", "scenes/pile.toml", "--duration", "60", "--out", out, "--events", ev]
     status, stderr = interrupt_while_writing(args, tmp_path)
     assert status == 130, stderr
     assert "interrupted" in stderr and "Traceback" not in stderr
@@ -382,8 +383,11 @@ def test_a_file_name_of_255_bytes_is_written(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == [name]
 
 
+STARTED: list[subprocess.Popen] = []
+
+
 def start(*args: str | Path, **kwargs) -> subprocess.Popen:
-    return subprocess.Popen(
+    proc = subprocess.Popen(
         [sys.executable, "-m", "ballpit", *map(str, args)],
         cwd=ROOT,
         stdout=subprocess.PIPE,
@@ -391,6 +395,19 @@ def start(*args: str | Path, **kwargs) -> subprocess.Popen:
         text=True,
         **kwargs,
     )
+    STARTED.append(proc)
+    return proc
+
+
+@pytest.fixture(autouse=True)
+def _no_run_outlives_its_test():
+    """A process ``start`` began is killed when its test ends (it has exited already unless the test
+    failed), so a failed test leaves no run stepping on."""
+    yield
+    while STARTED:
+        proc = STARTED.pop()
+        proc.kill()
+        proc.wait()
 
 
 def wait_for(condition, timeout: float = 60) -> None:
@@ -400,10 +417,11 @@ def wait_for(condition, timeout: float = 60) -> None:
         time.sleep(0.05)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_or_sighup_during_simulate_leaves_no_partial_file(tmp_path, signum):
     out, ev = tmp_path / "t.npz", tmp_path / "e.csv"
-    proc = start("simulate", "scenes/pile10k.toml", "--duration", "60", "--out", out, "--events", ev)
+    proc = start("simulate", "scenes/pile.toml", "--duration", "60", "--out", out, "--events", ev)
     wait_for(lambda: sum(p.name.endswith(".partial") for p in tmp_path.iterdir()) == 2)
     time.sleep(1.0)  # inside the stepping loop, with the writers open
     proc.send_signal(signum)
@@ -420,6 +438,7 @@ def _limit_file_size() -> None:
     resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))  # Python ignores SIGXFSZ: EFBIG
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("suffix", ["csv", "npz"])
 def test_a_write_that_fails_part_way_leaves_nothing(tmp_path, suffix):
     """A file size limit makes the writes fail part way as a full disk does: one line, exit 1, no file."""
@@ -459,6 +478,7 @@ def test_a_full_disk_leaves_nothing(small_disk, suffix):
     assert list(small_disk.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
     keep = tmp_path / "frames" / "notes.txt"  # not ours: stays
     keep.parent.mkdir()

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import os
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +25,7 @@ from .bouncing_box import (
     euler_gain_per_step_law,
     write_scene,
 )
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 FLIGHTS = 3
@@ -34,13 +34,7 @@ STEPS = round(DURATION / DT)
 
 
 def ballpit(*args: str | Path, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "ballpit", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=300,
-    )
+    return run_in_process(*args, cwd=cwd)
 
 
 def parse_table(stdout: str) -> dict[str, dict[str, float | str]]:
@@ -86,8 +80,8 @@ def test_cli_runs_and_prints_a_row_per_integrator(cli_run):
     assert r.returncode == 0, r.stderr
     assert "Traceback" not in r.stderr
     rows = parse_table(r.stdout)
-    assert list(rows) == ["euler", "rk2", "rk4", "reference"]
-    assert [rows[k]["steps"] for k in rows] == [STEPS, STEPS, STEPS, 4 * STEPS]
+    assert list(rows) == ["euler", "rk2", "rk4", "symplectic", "reference"]
+    assert [rows[k]["steps"] for k in rows] == [STEPS, STEPS, STEPS, STEPS, 4 * STEPS]
     assert f"initial energy {E0:.6g} J" in r.stdout  # m·g·y0
 
 
@@ -145,13 +139,16 @@ def test_python_api_matches_closed_form(tmp_path):
     assert scene.timestep == DT
     result = compare(scene.world, 1.0, scene.timestep, name="box")
     assert scene.world.time == 0.0  # every run stepped its own copy
-    euler, rk2, rk4 = result.runs
+    euler, rk2, rk4, symplectic = result.runs
     assert (euler.integrator, rk2.integrator, rk4.integrator) == ("euler", "rk2", "rk4")
+    assert symplectic.integrator == "symplectic"
     assert result.reference.dt == pytest.approx(DT / 4)
     landing = math.floor((V0 / G) / DT)  # steps before the first landing (exact motion)
     n = np.arange(landing - 1)
     expected = n * 0.5 * MASS * G**2 * DT**2
     np.testing.assert_allclose(euler.energy.drift[: len(n)], expected, rtol=1e-9, atol=1e-12 * E0)
+    # symplectic Euler loses what Euler gains: v_n = −g·n·dt, y_n = y0 − g·dt²·n(n+1)/2
+    np.testing.assert_allclose(symplectic.energy.drift[: len(n)], -expected, rtol=1e-9, atol=1e-12 * E0)
     # the same fall, state by state: v_n = −g·n·dt, y_n = y0 − g·dt²·n(n−1)/2
     np.testing.assert_allclose(euler.energy.kinetic[: len(n)], 0.5 * MASS * (G * n * DT) ** 2, atol=1e-12)
     assert rk4.max_abs_drift < 1e-9 * E0 and rk2.max_abs_drift < 1e-9 * E0

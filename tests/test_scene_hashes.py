@@ -1,6 +1,7 @@
 """Every bundled scene gives bit-identical results from one change to the next.
 
-Each scene runs for 2 s of simulated time at its own timestep; the hash covers every contact the
+Each scene runs for 2 s of simulated time at its own timestep (pile10k for 0.7 s: see below); the hash
+covers every contact the
 steps returned (time, kind, bodies, point, normal, impulse), the final state of every ball and the
 final time. A change that alters any of them on purpose (a physics fix) must update the hash here and
 say which scene changed and why in its commit message.
@@ -19,6 +20,10 @@ pile and pile10k, when Jacobi solves began to update friction in every fourth sw
 impulses alone in the others (#13: speed); the six other scenes never solve 64 contacts at once.
 pile and pile10k, when every solve of a crowded step became Jacobi, however few its contacts (#13:
 speed); no other scene takes a crowded step.
+pile10k, when its run was cut from 2 s to 0.7 s (#26: a faster suite): the 2 s run cost more than the
+rest of the hash test together. 0.7 s still holds its landing: the first contact at step 128, then 40
+crowded steps with some 300,000 contacts. The new hash is that of the same code (it was checked on the
+commit before the change, and under the Sandybridge/no-AVX settings), not of a physics change.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from ballpit.scene import read_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SECONDS = 2.0
+RUN_SECONDS = {"pile10k": 0.7}  # the rest run SECONDS
 HASHES = {
     "slopes": "36a8528b8a18082bac38998ec34ed841d60f3bf0a8fd2f051c23942bf69ce775",
     "cradle": "4f893dd8f2d151d5883149cd93af3aaefba83ccc7d8289a6121a877faad1150d",
@@ -40,7 +46,7 @@ HASHES = {
     "incline": "6ca212819d67c114b8ca2f7d5d49b05eb5e102c362d94034fc4b3052193024b0",
     "gas": "79e162b84f53a910af613dc94d8d339dee9ff8d29570023a3c7c26e15d627db8",
     "pile": "2ed3ffe792a2939ca1568c0e2102c482cf23422cdcfb0fc49b05c31b04ff7091",
-    "pile10k": "6b636cf3573033334a520a29e54401fff17fb6a403c54072ef6ee2f53a14fc38",
+    "pile10k": "feb0619418b1d3857f890d4521d6d9f0872662ec7d664f0bdd08e24aa38a274a",
     "seesaw": "62599274fca23f940b3383039e4887c86d7f9ad2a3f515d5c631e5fad3379d11",
 }
 
@@ -63,11 +69,13 @@ def test_every_bundled_scene_has_a_recorded_hash():
     assert {p.stem for p in SCENES.glob("*.toml")} == set(HASHES)
 
 
-@pytest.mark.parametrize("name", sorted(HASHES))
+@pytest.mark.parametrize(
+    "name", [pytest.param(n, marks=pytest.mark.slow) if n == "pile10k" else n for n in sorted(HASHES)]
+)
 def test_bundled_scene_runs_bit_identically(name):
-    assert scene_hash(SCENES / f"{name}.toml") == HASHES[name]
+    assert scene_hash(SCENES / f"{name}.toml", RUN_SECONDS.get(name, SECONDS)) == HASHES[name]
 
 
 if __name__ == "__main__":  # print the hashes of the scenes as they run now
     for p in sorted(SCENES.glob("*.toml")):
-        print(f'    "{p.stem}": "{scene_hash(p)}",')
+        print(f'    "{p.stem}": "{scene_hash(p, RUN_SECONDS.get(p.stem, SECONDS))}",')

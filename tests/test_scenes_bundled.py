@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +16,8 @@ import pytest
 
 from ballpit.scene import bundled_scenes, load_scene, read_scene
 from ballpit.viewer.camera import Camera
+
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
@@ -27,13 +28,7 @@ DEFAULT_STEPS = 24
 
 
 def ballpit(*args: str | Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "ballpit", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=timeout,
-    )
+    return run_in_process(*args, cwd=ROOT)
 
 
 def simulate_csv(tmp_path: Path, scene: str, *args: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -107,6 +102,7 @@ def test_cradle_passes_momentum_down_the_line(tmp_path):
     assert (kinds == "sphere-sphere").sum() >= 5
 
 
+@pytest.mark.slow
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):
     """The see-saw demo, judged from ``ballpit simulate`` output: the balls land on the plank, roll
     left (downhill), turn back as it tips over, and leave its right end for the floor."""

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,6 +18,8 @@ from ballpit.simulate import (
     run,
     step_plan,
 )
+
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -91,14 +91,13 @@ def read_profile(stdout: str) -> tuple[dict[str, float], str]:
     return ms, counts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("scene", "crowded"), [("slopes", False), ("pile", True)])
 def test_profile_prints_the_time_of_every_stage_and_the_counts_per_step(scene, crowded):
     from ballpit.physics.profile import STAGES
 
     command = ["simulate", f"scenes/{scene}.toml", "--duration", "0.8", "--profile", "-q"]
-    r = subprocess.run(
-        [sys.executable, "-m", "ballpit", *command], capture_output=True, text=True, cwd=ROOT, timeout=600
-    )
+    r = run_in_process(*command, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     ms, counts = read_profile(r.stdout)
     assert set(STAGES) | {"step"} == set(ms), r.stdout

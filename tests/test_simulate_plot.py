@@ -4,7 +4,6 @@ an Euler ball's fall, see bouncing_box.py) and the PNG written complete or not a
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,19 +15,14 @@ from ballpit.scene import load_scene
 from ballpit.simulate import run
 
 from .bouncing_box import DT, E0, MASS, V0, Y0, G, euler_gain_per_step_law, write_scene
+from .cli_runner import run_in_process
 from .test_cli import interrupt_while_writing
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def ballpit(*args: str | Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "ballpit", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-    )
+    return run_in_process(*args, cwd=ROOT)
 
 
 def test_run_records_the_energies_every_step(tmp_path):
@@ -90,6 +84,7 @@ def test_bad_plot_path_is_one_line_and_nothing_runs(tmp_path, plot, fragment):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["box.toml"]
 
 
+@pytest.mark.slow
 def test_interrupted_run_leaves_no_plot(tmp_path):
     scene = write_scene(tmp_path, dt=1e-4)
     png = tmp_path / "energy.png"

@@ -5,8 +5,6 @@ The reference is computed here by stepping the World directly, with nothing stre
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import tracemalloc
 from pathlib import Path
 
@@ -17,6 +15,8 @@ from ballpit import cli, writers
 from ballpit.physics import Contacts
 from ballpit.scene import read_scene
 from ballpit.simulate import step_plan
+
+from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SLOPES = ROOT / "scenes" / "slopes.toml"
@@ -120,13 +120,7 @@ def assert_npz_equals(path: Path, columns: dict, names: list[str]) -> None:
 
 
 def simulate(*args: str | Path) -> None:
-    r = subprocess.run(
-        [sys.executable, "-m", "ballpit", "simulate", *map(str, args), "-q"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-    )
+    r = run_in_process("simulate", *args, "-q", cwd=ROOT)
     assert r.returncode == 0, r.stderr
 
 
@@ -148,6 +142,7 @@ def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["e.csv", "e.npz", "t.csv", "t.npz"]
 
 
+@pytest.mark.slow
 def test_many_small_chunks_give_the_same_files(tmp_path, monkeypatch, slopes_reference):
     """Chunks of 7 rows: trajectory records and step contacts are split across many chunks."""
     monkeypatch.setattr(writers, "_CHUNK_ROWS", 7)
@@ -185,6 +180,7 @@ def peak_bytes(argv: list[str]) -> int:
         tracemalloc.stop()
 
 
+@pytest.mark.slow
 def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
     """2 s of 1,024 balls writes about 124 MB as .npz; held in memory, the peak grew by 140 MB.
 
@@ -204,6 +200,7 @@ def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
     assert peaks["2"] < 80e6, peaks
 
 
+@pytest.mark.slow
 def test_events_default_to_impacts_the_first_step_of_each_contact(tmp_path):
     """The slopes demo over 5 s: 1,710 contact rows, of which 47 are impacts (the bounces, the
     two mid-air collisions, the landings); the rest are balls resting or rolling on."""

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .allocator import keep_freed_memory
-from .cli import OneLineParser, _count, _positive, one_line
+from .arguments import OneLineParser, count, one_line, positive
 
 DT = 1 / 240
 RADIUS = 0.05
@@ -263,17 +263,17 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument(
-        "--steps", type=_count, default=None, help="steps to time (default: 1 s of simulation)"
+        "--steps", type=count, default=None, help="steps to time (default: 1 s of simulation)"
     )
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
     parser.add_argument(
         "--pybullet-up-to",
-        type=_count,
+        type=count,
         metavar="N",
         help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
     )
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
-    parser.add_argument("--timeout", type=_positive, default=1800.0, help="seconds allowed per measurement")
+    parser.add_argument("--timeout", type=positive, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )

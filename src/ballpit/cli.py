@@ -8,41 +8,29 @@ renderer, the benchmark) are imported only by the command that needs them.
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import signal
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import TYPE_CHECKING
 
 from . import __version__
 from .allocator import keep_freed_memory
+from .arguments import OneLineParser, one_line
+from .arguments import count as _count
+from .arguments import positive as _positive
+from .arguments import size as _size
 from .physics import INTEGRATOR_NAMES
+from .physics.integrators import INTEGRATORS
 
 if TYPE_CHECKING:
     from .physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
-
-
-class OneLineParser(argparse.ArgumentParser):
-    """argparse with a one-line error message (no usage block), still exit status 2.
-
-    Subcommand parsers made by ``add_subparsers`` are of the same class. Control characters in the
-    message (an option value holding a newline or a terminal escape) are shown escaped.
-    """
-
-    def error(self, message: str) -> NoReturn:  # type: ignore[override]
-        text = one_line(message, limit=500)
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {text} (see '{self.prog} --help')\n")
-
-
-def one_line(text: str, limit: int | None = None) -> str:
-    """``text`` with control characters escaped (so it stays one line), shortened to ``limit`` if given."""
-    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
-    return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
+_LABELS = [integrator.label for integrator in INTEGRATORS.values()]
+_INTEGRATOR_LABELS = ", ".join(_LABELS[:-1]) + " and " + _LABELS[-1]  # "Euler, RK2, RK4 and ..."
 
 
 class Terminated(BaseException):
@@ -82,39 +70,6 @@ def _install_stop_handlers() -> dict[int, object]:
 
 class UsageError(ValueError):
     """A command line whose options are each fine but that cannot be run (a run of 10¹² steps)."""
-
-
-def _positive(text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number of seconds, got {text!r}") from None
-    if not math.isfinite(x) or x <= 0:
-        raise argparse.ArgumentTypeError(f"must be positive and finite, got {text!r}")
-    return x
-
-
-def _count(text: str) -> int:
-    try:
-        k = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if k < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {text!r}")
-    return k
-
-
-def _size(text: str) -> tuple[int, int]:
-    parts = text.lower().split("x")
-    try:
-        w, h = (int(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"must be WIDTHxHEIGHT in pixels, like 960x540, got {text!r}"
-        ) from None
-    if w < 16 or h < 16 or w > 8192 or h > 8192:
-        raise argparse.ArgumentTypeError(f"must be between 16 and 8192 pixels each way, got {text!r}")
-    return w, h
 
 
 def _add_run_arguments(p: argparse.ArgumentParser) -> None:
@@ -181,9 +136,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "compare",
-        help="run a scene under Euler, RK2 and RK4 and compare energy drift and end positions",
-        description="Run the scene under Euler, RK2 and RK4 (each from its initial state) and RK4 at a "
-        "quarter of the step as a reference; print each one's total-energy drift and how far its balls "
+        help=f"run a scene under {_INTEGRATOR_LABELS} and compare energy drift and end positions",
+        description=f"Run the scene under {_INTEGRATOR_LABELS} (each from its initial state) and RK4 at "
+        "a quarter of the step as a reference; print each one's total-energy drift and how far its balls "
         "end from the reference's.",
     )
     _add_run_arguments(p)

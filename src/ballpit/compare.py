@@ -1,4 +1,4 @@
-"""``ballpit compare``: the same scene under Euler, RK2 and RK4, against an RK4 reference.
+"""``ballpit compare``: the same scene under every registered integrator, against an RK4 reference.
 
 Each integrator runs from its own copy of the scene's initial world at the scene's timestep; the
 reference is RK4 at a quarter of that step. For each run the table gives the total-energy drift
@@ -20,10 +20,11 @@ from tqdm import tqdm
 
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .physics import World
+from .physics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
 from .simulate import progress_bar, step_plan
 
-INTEGRATORS = ("euler", "rk2", "rk4")
-REFERENCE_INTEGRATOR = "rk4"
+INTEGRATORS = INTEGRATOR_NAMES
+REFERENCE_INTEGRATOR = DEFAULT_INTEGRATOR
 REFERENCE_DIVISOR = 4  # the reference's step is the scene's step over this
 DEFAULT_DURATION = 10.0  # s, when neither --duration nor the scene's [world] duration is given
 MAX_STEPS = 10**8  # steps of the reference run; a longer run is a mistake, not a job
@@ -92,12 +93,12 @@ class Run:
 
 @dataclass(frozen=True, eq=False)
 class Comparison:
-    """The three integrators' runs and the reference, all over the same duration."""
+    """Every integrator's run and the reference, all over the same duration."""
 
     name: str
     duration: float  # s
     dt: float  # s, the integrators' step
-    runs: tuple[Run, ...]  # euler, rk2, rk4
+    runs: tuple[Run, ...]  # in the order of INTEGRATORS
     reference: Run
 
     def distance(self, run: Run) -> tuple[float, float]:
@@ -135,7 +136,7 @@ def _run(
 def compare(
     initial: World, duration: float, dt: float, *, name: str = "scene", progress: bool = False
 ) -> Comparison:
-    """Run Euler, RK2 and RK4 at ``dt`` and the RK4 reference at ``dt / REFERENCE_DIVISOR``.
+    """Run every integrator at ``dt`` and the RK4 reference at ``dt / REFERENCE_DIVISOR``.
 
     ``initial`` is not changed: every run steps its own copy. Raises ``CompareError`` for a run of
     more than MAX_STEPS steps and lets ``FloatingPointError`` from the physics through.

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .energy_trace import EnergyRecorder, EnergyTrace
+from .physics.integrators import INTEGRATORS
 from .writers import AtomicFile, OutputError
 
 if TYPE_CHECKING:
@@ -21,11 +22,7 @@ if TYPE_CHECKING:
 PLOT_FORMATS = (".png", ".svg", ".pdf")
 PLOT_DPI = 120
 PLOT_SIZE = (8.0, 4.5)  # inches: 960 x 540 pixels at PLOT_DPI
-INTEGRATOR_STYLE = {
-    "euler": {"color": "#d62728"},
-    "rk2": {"color": "#ff7f0e"},
-    "rk4": {"color": "#1f77b4"},
-}
+INTEGRATOR_STYLE = {name: {"color": integrator.colour} for name, integrator in INTEGRATORS.items()}
 REFERENCE_STYLE = {"color": "0.35", "linestyle": "--"}
 
 

@@ -85,3 +85,29 @@ def test_few_boxes_give_the_same_pairs_in_the_same_order_either_way(n):
     bi, bj = np.triu_indices(n, 1)
     keep = np.all((lo[bi] <= hi[bj]) & (lo[bj] <= hi[bi]), axis=1)
     assert np.array_equal(i, bi[keep]) and np.array_equal(j, bj[keep])
+
+
+@pytest.mark.parametrize("case", ["a packed pile", "balls spread far apart", "a few very large boxes"])
+def test_the_sparse_and_the_dense_cell_lookups_find_the_same_pairs_in_the_same_order(case, monkeypatch):
+    """The grid's two ways of finding neighbouring cells (a table over every cell, or a search of the
+    sorted cell keys when the cells far outnumber the balls) give the same pairs, in the same order,
+    and both give exactly the overlapping boxes."""
+    rng = np.random.default_rng(11)
+    n = 300
+    sizes = rng.uniform(0.9, 1.1, n)
+    spread = {"a packed pile": 3.0, "balls spread far apart": 1.5, "a few very large boxes": 6.0}[case]
+    if case == "a few very large boxes":
+        sizes[rng.choice(n, 4, replace=False)] = 9.0
+    lo, hi = random_boxes(rng, n, spread, sizes)
+    if case == "balls spread far apart":  # ten small clusters up to 200 m apart: most cells are empty
+        shift = rng.uniform(-100.0, 100.0, (10, 3))[np.arange(n) % 10]
+        lo, hi = lo + shift, hi + shift
+    found = {}
+    for path, cells_per_ball in (("dense", 10**9), ("sparse", 0)):
+        monkeypatch.setattr(broadphase, "DENSE_CELLS_PER_BALL", cells_per_ball)
+        found[path] = broadphase.sphere_pairs(lo, hi)
+    assert np.array_equal(found["dense"][0], found["sparse"][0])
+    assert np.array_equal(found["dense"][1], found["sparse"][1])
+    pairs = set(zip(found["sparse"][0].tolist(), found["sparse"][1].tolist(), strict=True))
+    assert len(pairs) == len(found["sparse"][0]) and pairs == brute_force_pairs(lo, hi)
+    assert len(pairs) > 0

@@ -102,6 +102,7 @@ def test_momentum_is_conserved_exactly_in_ball_ball_contacts():
     assert (masses * world.spheres.velocities).sum(axis=0) == pytest.approx(p0, abs=1e-10)
 
 
+@pytest.mark.slow
 def test_stepping_the_same_scene_twice_is_bit_identical():
     def simulate() -> np.ndarray:
         rng = np.random.default_rng(3)

@@ -105,6 +105,7 @@ def test_fast_balls_in_a_crowd_stop_at_a_thin_plane():
     assert (world.spheres.velocities[:, 1] > 0).all()  # all bounced up, none passed through
 
 
+@pytest.mark.slow
 def test_a_crowded_pile_landing_never_gains_energy_and_nothing_sinks():
     # A block of 343 balls falls into a box; with restitution below one and friction, the total
     # energy can only fall, and the balls stay above the floor and apart from each other.

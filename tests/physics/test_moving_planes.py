@@ -80,6 +80,7 @@ def test_paddle_at_300_m_s_never_passes_a_small_ball(hz):
     assert ball.velocity[0] == pytest.approx((1 + e) * u, rel=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hz", RATES)
 def test_square_tilted_under_a_resting_ball_never_lets_it_sink_then_it_rolls_at_five_sevenths(hz):
     r, theta, rate = 0.2, math.radians(20.0), 0.25  # rad/s: about 1.4 s of tilting

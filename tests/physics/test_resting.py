@@ -15,6 +15,7 @@ def box(world: ballpit.World, half: float, height: float | None = None, **materi
         world.add_plane(position=(0, height, 0), normal=(0, -1, 0), **material)
 
 
+@pytest.mark.slow
 def test_a_few_hundred_balls_settle_into_a_still_pile():
     rng = np.random.default_rng(11)
     world = ballpit.World()
@@ -39,6 +40,7 @@ def test_a_few_hundred_balls_settle_into_a_still_pile():
     assert np.abs(world.spheres.positions[:, 1] - heights_before).max() < 1e-4  # still, not creeping
 
 
+@pytest.mark.slow
 def test_elastic_gas_in_a_closed_box_keeps_its_energy_for_a_minute():
     rng = np.random.default_rng(5)
     world = ballpit.World(gravity=(0, 0, 0))

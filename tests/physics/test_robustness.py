@@ -76,6 +76,7 @@ def test_a_ball_hit_hard_in_a_crowded_step_does_not_pass_through_the_floor():
     assert world.crowded_steps >= 1 and low.position[1] > r
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("velocity", "dt"), [((5000.0, 3000.0, 1000.0), 10.0), ((1e7, 3e6, 1e6), 1 / 240)])
 def test_no_speed_and_no_step_size_tunnels_out_of_a_box(velocity, dt):
     # Far more impacts than a step may be split into: the rest of the step is finished conservatively.
@@ -149,6 +150,7 @@ def test_mass_and_radius_columns_are_read_only():
         world.spheres.masses[:] = 2.0
 
 
+@pytest.mark.slow
 def test_total_energy_never_rises_in_a_closed_elastic_box_under_gravity():
     # Frictionless balls with e = 1: every bounce keeps the energy, so nothing may add any. Removing
     # overlaps by moving positions once lifted balls against gravity and the total crept up (1.4e-5
@@ -182,6 +184,7 @@ def deepest_overlaps(world: ballpit.World) -> tuple[float, float]:
     return balls, walls
 
 
+@pytest.mark.slow
 def test_the_bundled_pile_lands_with_overlaps_under_a_tenth_of_a_radius_and_rests_near_one_percent():
     # pile.toml once overlapped balls 725 and 735 by 19 % of a radius at t = 0.608 s while landing
     # (its floor by 9 %): pairs a bounce turned balls towards were left out of the crowded steps.

@@ -142,6 +142,7 @@ def test_switching_sleeping_off_wakes_every_ball():
     assert not world.asleep.any()
 
 
+@pytest.mark.slow
 def test_a_restored_snapshot_repeats_a_run_with_sleeping_bit_for_bit():
     world = ballpit.World(sleep=True)
     world.add_plane(friction=0.5, rolling_friction=0.2)

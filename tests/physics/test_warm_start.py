@@ -4,6 +4,7 @@ hands one pair's contact force to another."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import ballpit
 
@@ -32,6 +33,7 @@ def settled_pile() -> ballpit.World:
     return world
 
 
+@pytest.mark.slow
 def test_adding_a_ball_mid_run_leaves_every_other_contact_its_own_warm_start():
     # Two copies of the same run; one gets a ball on the far shelf. That ball touches nothing in the
     # pile, so the pile must go on exactly as in the other copy. Keys that depended on the ball count

@@ -146,6 +146,7 @@ def check_one(path: Path, text: str) -> None:
     assert outcomes[0] == outcomes[1] or outcomes[0][0] == outcomes[1][0] == 0, outcomes
 
 
+@pytest.mark.slow
 @settings(
     derandomize=True,
     max_examples=300,
@@ -158,6 +159,7 @@ def test_generated_hostile_scene_files_give_one_line_or_run(fuzz_file, text):
     check_one(fuzz_file, text)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "text",
     [

@@ -165,6 +165,7 @@ def test_one_grid_over_the_cap(tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_forty_thousand_sphere_tables_check_in_linear_time(tmp_path):
     # Re-adding every earlier block for each new sphere made this take 37 s; linear it takes a few.
     text = "".join(f"[[sphere]]\nposition = [{2 * k}, 1, 0]\n" for k in range(40_000))
@@ -240,7 +241,7 @@ def test_a_file_name_with_a_newline_and_an_escape_stays_on_one_line(tmp_path):
 @pytest.mark.parametrize(
     ("value", "start"),
     [
-        ("[" + ", ".join(["1"] * 1_000_000) + "]", "got [1, 1, 1, 1,"),
+        pytest.param("[" + ", ".join(["1"] * 1_000_000) + "]", "got [1, 1, 1, 1,", marks=pytest.mark.slow),
         ('"' + "x" * 200_000 + '"', 'got "xxxxxxxx'),
         ("[" + ", ".join(['"' + "y" * 100 + '"'] * 10) + "]", 'got ["yyyy'),
     ],

@@ -90,19 +90,63 @@ def subprocess_env(display: str | None) -> dict[str, str]:
     return env
 
 
-def run_driver(
-    driver: Path, display: str, name: str, workdir: Path, *extra: str, timeout: float = 300
-) -> dict:
-    """Run scenario ``name`` of a window driver script under ``display``; its ``RESULT <json>`` line."""
+def _run_scenarios(driver: Path, display: str, names: list[str], workdir: Path, *extra: str,
+                   timeout: float) -> dict[str, dict]:  # fmt: skip
+    """Run the scenarios ``names`` of a window driver script in one process under ``display``."""
     proc = subprocess.run(
-        [sys.executable, str(driver), name, str(workdir), *extra],
+        [sys.executable, str(driver), ",".join(names), str(workdir), *extra],
         env=subprocess_env(display), cwd=workdir, capture_output=True, text=True, timeout=timeout,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
-    assert "Traceback" not in proc.stderr, proc.stderr
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
-    assert lines, proc.stdout + proc.stderr
-    return json.loads(lines[-1][len("RESULT ") :])
+    results: dict[str, dict] = {}
+    for line in proc.stdout.splitlines():
+        if line.startswith(("RESULT ", "FAILED ")):
+            status, name, text = line.split(" ", 2)
+            results[name] = {"failed": json.loads(text)} if status == "FAILED" else json.loads(text)
+    for name in names:
+        assert name in results, proc.stdout + proc.stderr
+    return results
+
+
+def _moved(value: object, old: str, new: str) -> object:
+    """``value`` (a scenario's result) with the paths under ``old`` under ``new`` instead."""
+    if isinstance(value, str):
+        return new + value[len(old) :] if value == old or value.startswith(old + os.sep) else value
+    if isinstance(value, list):
+        return [_moved(v, old, new) for v in value]
+    if isinstance(value, dict):
+        return {k: _moved(v, old, new) for k, v in value.items()}
+    return value
+
+
+# Results of batched scenarios by (driver, display): one process ran them all.
+_BATCHES: dict[tuple[Path, str], dict[str, dict]] = {}
+
+
+def run_driver(
+    driver: Path, display: str, name: str, workdir: Path, *extra: str, timeout: float = 300,
+    batch: tuple[str, ...] = (),
+) -> dict:  # fmt: skip
+    """The result of scenario ``name`` of a window driver script, run under ``display``.
+
+    With ``batch`` (the driver's scenarios that need no extra arguments, ``name`` among them), the
+    first call runs them all in one process, one window after another, and later calls take their
+    result from that run: one Python start, one pyglet import and one GL set-up instead of one per test.
+    What a scenario wrote into its folder is copied into ``workdir``.
+    """
+    if not batch:
+        result = _run_scenarios(driver, display, [name], workdir, *extra, timeout=timeout)[name]
+    else:
+        assert name in batch and not extra
+        key = (driver, display)
+        folder = workdir.parent / f"batch-{driver.stem}"
+        if key not in _BATCHES:
+            folder.mkdir(exist_ok=True)
+            _BATCHES[key] = _run_scenarios(driver, display, list(batch), folder, timeout=timeout * len(batch))
+        result = _moved(_BATCHES[key][name], str(folder / name), str(workdir))
+        shutil.copytree(folder / name, workdir, dirs_exist_ok=True)
+    assert "failed" not in result, result.get("failed")
+    return result
 
 
 def line_of_balls(n: int = 5, y: float = 6.0, gravity: tuple = (0.0, -9.81, 0.0)) -> ballpit.World:

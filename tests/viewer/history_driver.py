@@ -8,7 +8,6 @@ from xdotool. The last stdout line is ``RESULT <json>``.
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 from pathlib import Path
 
@@ -19,6 +18,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import window_driver as wd
 
 import ballpit
+from ballpit.physics import INTEGRATOR_NAMES
+from ballpit.viewer.ghosts import TINTS
 from ballpit.viewer.screen import plot_rect, timeline_bar
 
 DT = 1 / 240  # the default timestep of a world built in code
@@ -136,9 +137,9 @@ def ghosts_and_plot(workdir: Path) -> dict:
     wd.press(viewer, "SPACE")
     steps = sim.timeline.history.current
     out: dict = {"steps": steps, "drifts": sim.timeline.drifts()}
-    # the same drift, worked out headless: the run and two plain copies under the other integrators
+    # the same drift, worked out headless: the run and plain copies under the other integrators
     expected = {}
-    for name in ("rk4", "euler", "rk2"):
+    for name in INTEGRATOR_NAMES:
         world = bounce_world()
         e0 = world.kinetic_energy() + world.potential_energy()
         world.integrator = name
@@ -153,7 +154,7 @@ def ghosts_and_plot(workdir: Path) -> dict:
     x, y, w, h = plot_rect(viewer.window.width, viewer.window.height)
     top = viewer.window.height - int(y + h)
     region = image[top : top + int(h), int(x) : int(x + w)]
-    tints = {"euler": (255, 97, 77), "rk4": (89, 204, 255)}
+    tints = {name: tuple(round(255 * c) for c in TINTS[name]) for name in ("euler", "rk4")}
     out["plot_pixels"] = {
         name: int((np.abs(region - np.array(c)).max(axis=-1) < 40).sum()) for name, c in tints.items()
     }
@@ -216,14 +217,5 @@ def replay(workdir: Path) -> dict:
 SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay)}
 
 
-def main() -> None:
-    scenario, workdir = sys.argv[1], Path(sys.argv[2])
-    result = SCENARIOS[scenario](workdir)
-    for viewer in wd.OPENED:
-        viewer.close()
-        viewer.pump()
-    print("RESULT " + json.dumps(result), flush=True)
-
-
 if __name__ == "__main__":
-    main()
+    wd.main(SCENARIOS)

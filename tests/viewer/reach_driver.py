@@ -8,13 +8,12 @@ key events from xdotool; the window, GL context, shaders and physics are all rea
 
 from __future__ import annotations
 
-import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
-from window_driver import OPENED, grab, hold, open_viewer, point_at, press, pump, settle, xdotool
+from window_driver import grab, hold, open_viewer, point_at, press, pump, settle, xdotool
+from window_driver import main as window_main
 
 from ballpit.viewer.app import Viewer
 from ballpit.viewer.picking import camera_basis
@@ -346,7 +345,7 @@ def record_close_button(workdir: Path) -> dict:
     """--record: drop, reset, drop again, then the window's close button (pyglet's on_close)."""
     path = workdir / "live.toml"
     path.write_text(RAMP_SCENE)
-    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz")
+    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz", samples=0)
     viewer.sim.step_budget = math.inf
     press(viewer, "X", frames=20)
     press(viewer, "R", frames=2)
@@ -367,14 +366,5 @@ SCENARIOS = {
 }
 
 
-def main() -> None:
-    scenario, workdir = sys.argv[1], Path(sys.argv[2])
-    result = SCENARIOS[scenario](workdir)
-    for viewer in OPENED:
-        viewer.close()
-        viewer.pump()
-    print("RESULT " + json.dumps(result), flush=True)
-
-
 if __name__ == "__main__":
-    main()
+    window_main(SCENARIOS)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ballpit.physics.integrators import INTEGRATORS
 from ballpit.viewer import controls
-from ballpit.viewer.controls import Action, action_for_key
+from ballpit.viewer.controls import Action, IntegratorAction, action_for_key
 
 DESIGN_TABLE = {
     "X": Action.START,
@@ -15,9 +16,10 @@ DESIGN_TABLE = {
     "RIGHT": Action.STEP,
     "R": Action.RESET,
     "F5": Action.RELOAD,
-    "_1": Action.EULER,
-    "_2": Action.RK2,
-    "_3": Action.RK4,
+    "_1": IntegratorAction.EULER,
+    "_2": IntegratorAction.RK2,
+    "_3": IntegratorAction.RK4,
+    "_4": IntegratorAction.SYMPLECTIC,
     "TAB": Action.CAPTURE_MOUSE,
     "ESCAPE": Action.ESCAPE,
     "C": Action.CONTACTS,
@@ -59,8 +61,17 @@ def test_unbound_keys_and_other_ctrl_chords_do_nothing():
 
 
 def test_number_keys_choose_the_integrators_by_name():
-    names = [controls.INTEGRATOR_ACTIONS[action_for_key(k)] for k in ("_1", "_2", "_3")]
-    assert names == ["euler", "rk2", "rk4"]
+    names = [controls.INTEGRATOR_ACTIONS[action_for_key(k)] for k in ("_1", "_2", "_3", "_4")]
+    assert names == ["euler", "rk2", "rk4", "symplectic"]
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS.values(), ids=lambda i: i.name)
+def test_each_registered_integrator_has_its_key_on_both_rows_and_in_the_help(integrator):
+    for name in (f"_{integrator.key}", f"NUM_{integrator.key}"):
+        assert controls.INTEGRATOR_ACTIONS[action_for_key(name)] == integrator.name
+    keys, what = next(row for row in controls.HELP if "faster" in row[1])
+    assert integrator.key in keys.replace(",", "/").split("/")
+    assert integrator.label in what
 
 
 def test_fly_keys_give_unit_camera_relative_directions():
@@ -104,7 +115,7 @@ def test_escape_releases_a_captured_mouse_and_quits_only_when_pressed_again():
 
 def test_help_lists_every_control_of_the_design_table():
     keys = " ".join(k for k, _ in controls.HELP)
-    for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1 / 2 / 3", "+ / −", "W A S D", "Q E",
+    for label in ("X", "Space", "N", "→", "R", "Ctrl+R", "F5", "1/2/3/4", "+ / −", "W A S D", "Q E",
                   "Shift", "Tab", "Esc", "C / V / T", "H / F1", "F12", "←", "Shift+←", "G", "P"):  # fmt: skip
         assert label in keys, label
     assert "scroll" in " ".join(w for _, w in controls.HELP)

@@ -21,8 +21,21 @@ DRIVER = Path(__file__).with_name("reach_driver.py")
 needs_xdotool = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
 
+# every scenario of reach_driver.py: the first test to ask runs them all in one window process
+BATCH = (
+    "drag_throw",
+    "drag_throw_paused",
+    "shoot",
+    "plane_tilt",
+    "plane_lift",
+    "home",
+    "save",
+    "record_close_button",
+)
+
+
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    return run_driver(DRIVER, display, name, workdir, timeout=180)
+    return run_driver(DRIVER, display, name, workdir, timeout=180, batch=BATCH)
 
 
 def drag_velocity(r: dict) -> np.ndarray:

@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 
 from .conftest import REPO, run_driver, subprocess_env
-from .window_driver import GOOD_SCENE
+from .window_driver import GOOD_SCENE, SCENARIOS
 
 DRIVER = Path(__file__).with_name("window_driver.py")
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    return run_driver(DRIVER, display, name, workdir, timeout=120)
+    return run_driver(DRIVER, display, name, workdir, timeout=120, batch=tuple(SCENARIOS))
 
 
 def test_the_title_shows_the_frame_rate(xvfb, tmp_path):

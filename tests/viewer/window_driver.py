@@ -41,7 +41,9 @@ OPENED: list[Viewer] = []
 
 
 def open_viewer(size: tuple[int, int] = (320, 180), **kwargs: object) -> Viewer:
-    viewer = Viewer(size=size, **kwargs)
+    """A viewer window without multisampling (no scenario looks at anti-aliased edges; the renderer
+    tests do), at ``size``."""
+    viewer = Viewer(size=size, samples=0, **kwargs)
     viewer.sim.step_budget = math.inf  # exact simulated time per frame even on a loaded machine
     OPENED.append(viewer)
     return viewer
@@ -445,13 +447,27 @@ SCENARIOS = {
 }
 
 
-def main() -> None:
-    scenario, workdir = sys.argv[1], Path(sys.argv[2])
-    result = SCENARIOS[scenario](workdir)
-    for viewer in OPENED:
-        viewer.close()
-        viewer.pump()  # outside pyglet's loop the window closes on the next pump
-    print("RESULT " + json.dumps(result), flush=True)
+def main(scenarios: dict | None = None) -> None:
+    """``python DRIVER NAME[,NAME...] WORKDIR [EXTRA...]``: run the scenarios one after another in this
+    process, each in a window of its own and in a folder of its own (``WORKDIR/NAME``; WORKDIR itself
+    for a single one), and print ``RESULT NAME <json>`` (or ``FAILED NAME <traceback as json>``) for each."""
+    import traceback
+
+    scenarios = SCENARIOS if scenarios is None else scenarios
+    names, workdir = sys.argv[1].split(","), Path(sys.argv[2])
+    for name in names:
+        folder = workdir if len(names) == 1 else workdir / name
+        folder.mkdir(parents=True, exist_ok=True)
+        os.chdir(folder)  # where a scenario's screenshots and saves go
+        OPENED.clear()
+        try:
+            line = f"RESULT {name} " + json.dumps(scenarios[name](folder))
+        except Exception:
+            line = f"FAILED {name} " + json.dumps(traceback.format_exc())
+        for viewer in OPENED:
+            viewer.close()
+            viewer.pump()  # outside pyglet's loop the window closes on the next pump
+        print(line, flush=True)
 
 
 if __name__ == "__main__":

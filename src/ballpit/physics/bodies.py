@@ -9,15 +9,21 @@ hand out whole columns (``world.spheres.positions``) for code that works on ever
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-from typing import TYPE_CHECKING, overload
+from typing import Protocol, overload
 
 import numpy as np
 
 from . import collision, validation
-from .state import Columns, Q, V, W, X
+from .model import Model
+from .state import Columns, Q, State, V, W, X
 
-if TYPE_CHECKING:
-    from .world import World
+
+class World(Protocol):
+    """What a view reads and writes: the world's model and state (``world.World`` has both). A
+    protocol, so this module need not import the facade that imports it."""
+
+    model: Model
+    state: State
 
 
 _LIMITS = {

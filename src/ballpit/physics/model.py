@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
-from .integrators import INTEGRATORS, Integrator
+from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
 from .state import Columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
@@ -73,7 +73,7 @@ class Model:
         self.spheres = sphere_columns()
         self.planes = plane_columns()
         self.gravity = np.array([0.0, -9.81, 0.0])
-        self.integrator: Integrator = INTEGRATORS["rk4"]
+        self.integrator: Integrator = INTEGRATORS[DEFAULT_INTEGRATOR]
         self.linear_drag = 0.0
         self.angular_drag = 0.0
         self.restitution_threshold: float | None = None

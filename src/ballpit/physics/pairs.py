@@ -86,8 +86,8 @@ class KeptPairs:
             # from the first only in the sign of a zero moves ``end`` by a signed zero at most, which
             # none of the comparisons below can tell apart.
             accel = accel[:1]
-        pad = radius + path.sag(accel, h)
-        lift = path.path_acceleration(accel).T * (0.5 * h * h)  # ½h²·a along the path (0 if straight)
+        pad = radius + path.sag(np.linalg.norm(accel, axis=1), h)
+        lift = path.path_offset(accel, h).T  # ½h²·b: the path's bend (0 if straight)
         shared = lift.shape[1] == 1
         size = min(n, ESCAPE_CHUNK)
         x, end, d, e = (np.empty((3, size)) for _ in range(4))
@@ -100,7 +100,7 @@ class KeptPairs:
             np.copyto(xs, body[rows, X].T)
             np.multiply(body[rows, V].T, h, out=ends)
             ends += xs  # x + v·h
-            ends += lift if shared else lift[:, rows]  # … + ½h²·a
+            ends += lift if shared else lift[:, rows]  # … + ½h²·b
             # the box around the chord, grown by pad, inside the kept box
             np.minimum(xs, ends, out=ds)
             ds -= pads
@@ -189,10 +189,10 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, 1e-12), h, max(h, ahead))
     now = path.path_end(x, v, accel_t, h)
     later = path.path_end(x, v, free_t, horizon)
-    # a parabola strays at most ⅛·|a|·t² from its chord
+    # how far the paths can stray from their chords, over this step and over the horizon
     free_norm = _norm(free_t, scratch, np.empty(n))
     accel_norm = free_norm if accel is free else _norm(accel_t, scratch, np.empty(n))
-    sag = 0.125 * (accel_norm * h * h + free_norm * horizon**2)
+    sag = path.cover_sag(accel_norm, h) + path.cover_sag(free_norm, horizon)
     pad = radius + sag + BROAD_PHASE_MARGIN * radius + CONTACT_SLOP
     lo = np.minimum(x, now)
     np.minimum(lo, later, out=lo)

@@ -102,10 +102,10 @@ def meetings(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h:
     if apart.size == 0:
         return none, none, apart
     body, path = state.body, model.integrator
-    x, v = with_static(body[:, X]), with_static(body[:, V])
-    acc = path.path_acceleration(with_static(accel))
+    x, v, accel = with_static(body[:, X]), with_static(body[:, V]), with_static(accel)
+    acc = path.path_acceleration(accel)
     a, b = c.a[apart], c.b[apart]
-    bound = path.closing_speed_bound(v[a] - v[b], acc[a] - acc[b], h)
+    bound = path.closing_speed_bound(v[a] - v[b], accel[a] - accel[b], h)
     if model.moving_planes():  # a plane's surface moves too: bound its approach as well
         on = c.kind[apart] == SPHERE_PLANE
         bound[on] = moving_planes.closing_speed_bound(
@@ -126,8 +126,8 @@ def meetings(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h:
 
     def gap_at(k: np.ndarray, t: np.ndarray) -> np.ndarray:
         tt = t[:, None]
-        pa = x[a[k]] + v[a[k]] * tt + 0.5 * acc[a[k]] * tt * tt
-        pb = x[b[k]] + v[b[k]] * tt + 0.5 * acc[b[k]] * tt * tt
+        pa = path.position_at(x[a[k]], v[a[k]], accel[a[k]], tt)
+        pb = path.position_at(x[b[k]], v[b[k]], accel[b[k]], tt)
         plane_k = on_plane[k]
         if plane_k.any():
             pk = c.other[apart[k[plane_k]]]

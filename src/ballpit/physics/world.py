@@ -98,7 +98,7 @@ class World:
 
     @property
     def integrator(self) -> str:
-        """ "euler", "rk2" or "rk4"; may be changed between steps."""
+        """One of ``INTEGRATOR_NAMES`` ("euler", "rk2", "rk4", "symplectic"); may be changed between steps."""
         return self.model.integrator.name
 
     @integrator.setter

@@ -40,7 +40,8 @@ def title(scene_name: str, fps: float) -> str:
 
 class Viewer:
     """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
-    file ``scene_path`` (the bundled demo by default)."""
+    file ``scene_path`` (the bundled demo by default). ``samples``: the multisampling asked for (4×
+    MSAA; 0 for none, as the window tests use to draw 4× less on a software rasteriser)."""
 
     def __init__(
         self,
@@ -50,6 +51,7 @@ class Viewer:
         visible: bool = True,
         trajectory: object = None,
         record: Path | None = None,
+        samples: int = 4,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -77,7 +79,7 @@ class Viewer:
             self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
-        self.window = self._open_window(size, visible)
+        self.window = self._open_window(size, visible, samples)
         self.renderer = Renderer()
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
@@ -105,14 +107,14 @@ class Viewer:
         self._pyglet = pyglet
 
     # ------------------------------------------------------------------ window
-    def _open_window(self, size: tuple[int, int], visible: bool):
+    def _open_window(self, size: tuple[int, int], visible: bool, samples: int):
         import pyglet
         from pyglet import gl
 
         base = dict(
             major_version=3, minor_version=3, forward_compatible=True, double_buffer=True, depth_size=24
         )
-        attempts = [dict(base, sample_buffers=1, samples=4), base]
+        attempts = [dict(base, sample_buffers=1, samples=samples), base] if samples else [base]
         for i, attrs in enumerate(attempts):
             try:
                 window = pyglet.window.Window(

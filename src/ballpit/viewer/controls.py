@@ -5,7 +5,8 @@ Keys are named as in ``pyglet.window.key`` (``key.symbol_string(symbol)``: "X", 
 and when Shift is let go first X reports the release as EQUAL, so pyglet still believes PLUS is held and
 swallows the next press; the text event arrives every time, from the main keys and the keypad alike.
 The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of the F1 overlay
-and is built from the same bindings.
+and is built from the same bindings. The number keys come from the integrator registry
+(``physics/integrators.py``): one ``IntegratorAction`` per registered integrator, on its key.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from ..physics.integrators import INTEGRATORS
+
 
 class Action(Enum):
     """Everything a key press can ask the viewer to do."""
@@ -25,9 +28,6 @@ class Action(Enum):
     STEP = "single step while paused"
     RESET = "reset to the initial state"
     RELOAD = "reload the scene file"
-    EULER = "integrator: Euler"
-    RK2 = "integrator: RK2"
-    RK4 = "integrator: RK4"
     FASTER = "faster time"
     SLOWER = "slower time"
     CAPTURE_MOUSE = "capture / release the mouse for looking"
@@ -57,12 +57,6 @@ KEY_ACTIONS: dict[str, Action] = {
     "RIGHT": Action.STEP,
     "R": Action.RESET,
     "F5": Action.RELOAD,
-    "_1": Action.EULER,
-    "NUM_1": Action.EULER,
-    "_2": Action.RK2,
-    "NUM_2": Action.RK2,
-    "_3": Action.RK4,
-    "NUM_3": Action.RK4,
     "TAB": Action.CAPTURE_MOUSE,
     "ESCAPE": Action.ESCAPE,
     "C": Action.CONTACTS,
@@ -95,7 +89,19 @@ TEXT_ACTIONS: dict[str, Action] = {
     "\u2212": Action.SLOWER,  # − (minus sign), as some layouts type it
 }
 
-INTEGRATOR_ACTIONS: dict[Action, str] = {Action.EULER: "euler", Action.RK2: "rk2", Action.RK4: "rk4"}
+# Switching integrator: one action per registered integrator (``IntegratorAction.RK4``, ...), bound to
+# its number key on the main keys and the keypad.
+IntegratorAction = Enum(  # type: ignore[misc]
+    "IntegratorAction", {name.upper(): f"integrator: {i.label}" for name, i in INTEGRATORS.items()}
+)
+INTEGRATOR_ACTIONS: dict[Enum, str] = {IntegratorAction[name.upper()]: name for name in INTEGRATORS}
+KEY_ACTIONS.update(
+    {
+        f"{row}{INTEGRATORS[name].key}": action
+        for action, name in INTEGRATOR_ACTIONS.items()
+        for row in ("_", "NUM_")
+    }  # type: ignore[misc]
+)
 
 # Held keys that fly the camera, as (right, up, forward) components.
 FLY_KEYS: dict[str, tuple[float, float, float]] = {
@@ -125,7 +131,10 @@ HELP: tuple[tuple[str, str], ...] = (
     ("N or →", "single step while paused"),
     ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
     ("R / Ctrl+R or F5", "reset (X drops again) / reload (also on save)"),
-    ("1 / 2 / 3, + / −", "Euler / RK2 / RK4; faster / slower time"),
+    (
+        "/".join(i.key for i in INTEGRATORS.values()) + ", + / −",
+        "/".join(i.label for i in INTEGRATORS.values()) + "; faster/slower time",
+    ),
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),

@@ -1,4 +1,4 @@
-"""Integrator ghosts (G): the same scene stepped in lockstep under the other two integrators.
+"""Integrator ghosts (G): the same scene stepped in lockstep under every other registered integrator.
 
 Each ghost is a ``World.copy()`` of the run at a common origin (the drop, when it can catch up from
 there quickly; else the moment G was pressed) with its ``integrator`` set, and keeps its own History so
@@ -10,12 +10,13 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..physics.integrators import INTEGRATORS as REGISTRY
 from .history import History
 
-INTEGRATORS = ("euler", "rk2", "rk4")
-LABELS = {"euler": "Euler", "rk2": "RK2", "rk4": "RK4"}
-# Ghost tint per integrator (linear RGB): what the HUD legend and the energy plot use too.
-TINTS = {"euler": (1.0, 0.38, 0.3), "rk2": (1.0, 0.82, 0.25), "rk4": (0.35, 0.8, 1.0)}
+INTEGRATORS = tuple(REGISTRY)
+LABELS = {name: integrator.label for name, integrator in REGISTRY.items()}
+# Ghost tint per integrator (sRGB, its registered colour): what the HUD legend and the energy plot use too.
+TINTS = {name: integrator.rgb for name, integrator in REGISTRY.items()}
 GHOST_ALPHA = 0.38
 CATCH_UP_STEPS = 720  # at most this many steps of re-running from the drop when G is pressed
 
@@ -30,7 +31,7 @@ def drift_percent(energy: float, reference: float) -> float:
 
 
 class Ghosts:
-    """The two integrators the main run is not using, stepped alongside it."""
+    """The integrators the main run is not using, stepped alongside it."""
 
     def __init__(self, main: Any, origin: Any, origin_step: int, history: History | None) -> None:
         """``origin`` is a snapshot of ``main`` at ``origin_step``; the ghosts are re-run from it up to

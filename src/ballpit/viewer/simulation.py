@@ -160,7 +160,9 @@ class Simulation:
                 f"{trajectory.path}: the trajectory has {trajectory.balls} balls, the scene {self.ball_count}"
             )
             trajectory = None
-        self.timeline = Timeline(self, trajectory)
+        self.timeline = Timeline(
+            self.world, self.timestep, trajectory, on_seek=self.after_seek, on_replay_end=self.end_of_replay
+        )
         if trajectory is not None:
             self.after_seek(None)  # frame 0 of the replay is in the world now
         if ghosts:

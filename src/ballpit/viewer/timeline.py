@@ -3,12 +3,15 @@ integrator ghosts and the energy trace.
 
 ``Timeline`` is the one object the Simulation calls into: ``step`` takes a live step (and records it,
 and steps the ghosts) or plays a replay on; ``back``, ``forward``, ``jump`` and ``scrub`` move in time
-while paused; ``toggle_ghosts`` starts or stops the ghosts. No GL here.
+while paused; ``toggle_ghosts`` starts or stops the ghosts. It knows the world and the timestep, not
+the Simulation: what the Simulation must hear about (a seek, the end of a replay) it is told through
+the two callbacks it hands in. No GL here.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -17,19 +20,30 @@ from .ghosts import CATCH_UP_STEPS, Ghosts, total_energy
 from .history import History
 from .replay import Replay, Trajectory
 
-if TYPE_CHECKING:
-    from .simulation import Simulation
-
 JUMP_SECONDS = 1.0  # Shift+← / Shift+→
 
 
 class Timeline:
-    """History (live runs) or Replay (trajectories), ghosts and the energy trace of one Simulation."""
+    """History (live runs) or Replay (trajectories), ghosts and the energy trace of one world.
 
-    def __init__(self, sim: Simulation, trajectory: Trajectory | None = None) -> None:
-        self.sim = sim
+    ``on_seek(contacts)`` is called after every move in time (with the contacts of the step reached,
+    when the source kept them), ``on_replay_end()`` when a replay has shown its last frame.
+    """
+
+    def __init__(
+        self,
+        world: Any,
+        timestep: float,
+        trajectory: Trajectory | None = None,
+        *,
+        on_seek: Callable[[Any], None],
+        on_replay_end: Callable[[], None],
+    ) -> None:
+        self.world = world
+        self.timestep = timestep
+        self._on_seek, self._on_replay_end = on_seek, on_replay_end
         self.history: History | None = None
-        self.replay: Replay | None = Replay(sim.world, trajectory) if trajectory is not None else None
+        self.replay: Replay | None = Replay(world, trajectory) if trajectory is not None else None
         self.ghosts: Ghosts | None = None
         self.energy = EnergyTrace()
         self._origin: Any = None  # the drop's snapshot, for ghosts started later
@@ -43,7 +57,7 @@ class Timeline:
     @property
     def steps_per_second(self) -> float:
         source = self.source
-        return 1.0 / source.timestep if source is not None else 1.0 / self.sim.timestep
+        return 1.0 / source.timestep if source is not None else 1.0 / self.timestep
 
     def span(self) -> tuple[float, float, float] | None:
         """(oldest, current, newest) seconds of the span kept, or None before the drop."""
@@ -56,17 +70,17 @@ class Timeline:
     def started(self) -> None:
         """X: the drop. A live run starts its history here."""
         if self.replay is None and self.history is None:
-            self.history = History(self.sim.world, self.sim.timestep)
-            self._origin = self.sim.world.snapshot()
+            self.history = History(self.world, self.timestep)
+            self._origin = self.world.snapshot()
             if self.ghosts is not None:  # G before X: the ghosts start with the drop
-                self.ghosts = Ghosts(self.sim.world, self._origin, 0, self.history)
+                self.ghosts = Ghosts(self.world, self._origin, 0, self.history)
 
     def step(self, dt: float) -> Any:
         """One fixed step: the physics (recorded, ghosts alongside) or the next replay frame."""
-        world = self.sim.world
+        world = self.world
         if self.replay is not None:
             if not self.replay.advance(dt):
-                self.sim.end_of_replay()
+                self._on_replay_end()
             return _no_contacts()
         contacts = world.step(dt)
         if self.history is not None:
@@ -92,7 +106,7 @@ class Timeline:
         source.seek(step)
         if self.ghosts is not None:
             self.ghosts.seek(source.current)
-        self.sim.after_seek(getattr(source, "last_contacts", None))
+        self._on_seek(getattr(source, "last_contacts", None))
         return True
 
     def back(self) -> bool:
@@ -125,7 +139,7 @@ class Timeline:
             return "ghosts off"
         if self.replay is not None:
             return "ghosts need a live run, not a replay"
-        world = self.sim.world
+        world = self.world
         h = self.history
         if h is None:  # before the drop: they start with it
             self.ghosts = Ghosts(world, world.snapshot(), 0, None)
@@ -137,7 +151,7 @@ class Timeline:
         return f"ghosts on: energy drift since t = {world.time:.2f} s"
 
     def drifts(self) -> list[tuple[str, float, bool]]:
-        return self.ghosts.drifts(self.sim.world) if self.ghosts is not None else []
+        return self.ghosts.drifts(self.world) if self.ghosts is not None else []
 
     def ghost_worlds(self) -> list[tuple[str, Any]]:
         return list(self.ghosts.worlds.items()) if self.ghosts is not None else []
@@ -145,7 +159,7 @@ class Timeline:
     # ------------------------------------------------------------------ energy
     def sample_energy(self) -> None:
         """One sample of the energy trace at the world's time (once per frame)."""
-        world = self.sim.world
+        world = self.world
         kinetic, potential = world.kinetic_energy(), world.potential_energy()
         totals = {world.integrator: kinetic + potential}
         for name, ghost in self.ghost_worlds():
