@@ -18,13 +18,16 @@ from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
 from .allocator import keep_freed_memory
-from .physics import INTEGRATOR_NAMES
+
+# Nothing heavy above this line (``ballpit`` imports NumPy only on first use): ``main`` installs its
+# Ctrl+C and SIGTERM handlers before the physics, the scene reader or the viewer are imported.
 
 if TYPE_CHECKING:
     from .physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a tool cut off by `| head`
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -129,6 +132,8 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
+    from .physics import INTEGRATOR_NAMES
+
     parser = OneLineParser(
         prog="ballpit",
         description="Balls, slopes, spin and impacts: a physics sandbox with a viewer and a headless runner.",
@@ -213,7 +218,41 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status."""
+    """Run the command line; returns the exit status.
+
+    The stop handlers come first, so Ctrl+C or SIGTERM while the modules still import exits 130 or
+    143 with one line, never a traceback. A closed stdout (``| head``) ends the run quietly.
+    """
+    previous = _install_stop_handlers()
+    try:
+        status = _run(argv)
+        sys.stdout.flush()  # here, not at exit, so a closed pipe is caught below
+        return status
+    except KeyboardInterrupt:
+        print("ballpit: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Terminated as e:
+        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null, so the interpreter's last flush of what is left finds no closed pipe."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout replaced by something without a descriptor
+        pass
+
+
+def _run(argv: Sequence[str] | None) -> int:
     keep_freed_memory()
     args_list = list(sys.argv[1:] if argv is None else argv)
     if args_list and args_list[0] == "bench":
@@ -225,7 +264,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .scene import SceneError
     from .writers import OutputError, OutputFailed
 
-    previous = _install_stop_handlers()
     try:
         return int(args.handler(args) or EXIT_OK)
     except (SceneError, OutputError, UsageError) as e:
@@ -234,15 +272,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OutputFailed as e:
         print(f"ballpit: {one_line(str(e))}; nothing was written", file=sys.stderr)
         return EXIT_FAILED
-    except KeyboardInterrupt:
-        print("ballpit: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Terminated as e:
-        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
 
 
 def _looks_like_scene(arg: str) -> bool:
@@ -286,7 +315,7 @@ class StepTotals:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from .simulate import MAX_STEPS, format_summary, run, step_count
+    from .simulate import MAX_STEPS, format_summary, run, step_count, step_longer_than_run
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
     info = _load(args.scene)
@@ -295,8 +324,11 @@ def _simulate(args: argparse.Namespace) -> int:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
     duration = args.duration or info.duration or 10.0
+    source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
+    too_long = step_longer_than_run(duration, dt)
+    if too_long:
+        raise UsageError(f"{source}: {too_long}")
     if not step_count(duration, dt) <= MAX_STEPS:
-        source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
         raise UsageError(
             f"{source}: {duration:g} s in steps of {dt:g} s is {step_count(duration, dt):.3g} steps; "
             f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"

@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .physics import World
-from .simulate import progress_bar, step_plan
+from .simulate import progress_bar, step_longer_than_run, step_plan
 
 INTEGRATORS = ("euler", "rk2", "rk4")
 REFERENCE_INTEGRATOR = "rk4"
@@ -226,6 +226,10 @@ def main(args: argparse.Namespace) -> int:
     scene = open_scene(args.scene)
     dt = args.dt or scene.timestep
     duration = args.duration or scene.duration or DEFAULT_DURATION
+    too_long = step_longer_than_run(duration, dt)
+    if too_long:
+        print(f"ballpit: {scene.name}: {too_long}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     plot = PlotFile(args.plot) if args.plot is not None else None
     try:
         try:

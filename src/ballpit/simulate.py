@@ -125,9 +125,20 @@ def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
     whole = math.floor(duration / dt + 1e-9)
     rest = duration - whole * dt
     plan = [(whole, dt)] if whole else []
-    if rest > 1e-9 * dt:
+    if rest > 1e-9 * min(dt, duration):  # a step longer than the run: one step of the whole run
         plan.append((1, rest))
     return plan
+
+
+def step_longer_than_run(duration: float, dt: float) -> str | None:
+    """What is wrong when a step of ``dt`` is longer than the whole run (the command line refuses it:
+    the run would be one step of ``duration`` instead), else None."""
+    if dt <= duration * (1 + 1e-9):
+        return None
+    return (
+        f"a step of {dt:g} s is longer than the run ({duration:g} s): "
+        "use a smaller --dt or a longer --duration"
+    )
 
 
 def progress_bar(total: int, name: str, progress: bool) -> tqdm:
@@ -171,6 +182,7 @@ def run(
     total = sum(n for n, _ in plan)
     balls = world.spheres
     start_energy = energy(world)
+    start_time = world.time
 
     def record() -> None:
         if trajectory is not None:
@@ -204,7 +216,7 @@ def run(
     wall = clock.perf_counter() - began
     return RunSummary(
         steps=done,
-        sim_time=duration,
+        sim_time=world.time - start_time,  # what was stepped, so an interrupted or odd plan says so
         wall_time=wall,
         sphere_plane_contacts=int(counts[SPHERE_PLANE]),
         sphere_sphere_contacts=int(counts[SPHERE_SPHERE]),

@@ -1,0 +1,83 @@
+"""The command line under hostile conditions (issue #25, section 3): a closed stdout, a stop signal
+while the modules still import, a step longer than the run. In-process where the process itself is
+not the point."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import ballpit
+from ballpit import cli
+from ballpit.simulate import run
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_a_closed_stdout_ends_the_run_quietly():
+    """`ballpit scenes | head -0`: the reader is gone before anything is written."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "ballpit", "scenes"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    proc.stdout.close()
+    stderr = proc.stderr.read()
+    proc.wait(timeout=60)
+    assert "Traceback" not in stderr and "BrokenPipeError" not in stderr, stderr
+    assert stderr == ""
+    assert proc.returncode == cli.EXIT_BROKEN_PIPE
+
+
+_SIGNAL_WHILE_IMPORTING = """
+import builtins, os, signal, sys
+import ballpit.cli as cli
+assert not any(m.split(".")[0] == "numpy" for m in sys.modules), "the command line imported NumPy"
+real = builtins.__import__
+def hooked(name, *args, **kwargs):
+    if name.split(".")[0] == "numpy":  # the first heavy import: the physics, inside main
+        builtins.__import__ = real
+        os.kill(os.getpid(), signal.{signal})
+    return real(name, *args, **kwargs)
+builtins.__import__ = hooked
+sys.exit(cli.main(["check", "slopes"]))
+"""
+
+
+@pytest.mark.parametrize(("name", "status"), [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_stop_signal_while_the_modules_import_exits_quietly(name, status):
+    code = _SIGNAL_WHILE_IMPORTING.replace("{signal}", name)
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert r.returncode == status, r.stderr
+    assert "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+@pytest.mark.parametrize("command", ["simulate", "compare"])
+def test_a_step_longer_than_the_run_is_refused_in_one_line(command, capsys):
+    status = cli.main([command, "slopes", "--dt", "1e10", "--duration", "5", "-q"])
+    err = capsys.readouterr().err
+    assert status == cli.EXIT_BAD_INPUT
+    assert len(err.strip().splitlines()) == 1
+    assert "a step of 1e+10 s is longer than the run (5 s)" in err
+
+
+def test_run_reports_the_time_it_stepped_when_the_step_is_longer_than_the_run():
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_sphere(position=(0, 0, 0), velocity=(1, 0, 0))
+    summary = run(world, 5.0, 1e10)
+    assert summary.steps == 1
+    assert summary.sim_time == world.time == 5.0
+    assert world.spheres[0].position[0] == pytest.approx(5.0)  # x = v·t: 5 s were stepped
+
+
+def test_the_stop_handlers_are_restored_after_main(capsys):
+    before = signal.getsignal(signal.SIGTERM)
+    assert cli.main(["check", "slopes"]) == 0
+    assert signal.getsignal(signal.SIGTERM) is before
