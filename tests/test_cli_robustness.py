@@ -4,9 +4,11 @@ not the point."""
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -81,3 +83,32 @@ def test_the_stop_handlers_are_restored_after_main(capsys):
     before = signal.getsignal(signal.SIGTERM)
     assert cli.main(["check", "slopes"]) == 0
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_a_run_killed_outright_leaves_a_visible_partial_file_that_the_next_run_removes(tmp_path, capsys):
+    out = tmp_path / "run.npz"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "ballpit", "simulate", "pile", "--duration", "60", "--out", str(out), "-q"],
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not list(tmp_path.glob("*.partial")) and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        proc.kill()
+        proc.wait(timeout=60)
+    left = [p.name for p in tmp_path.iterdir()]
+    assert left == [f"run.npz.{proc.pid}.partial"]  # in plain sight, named as unfinished
+    assert cli.main(["simulate", "slopes", "--duration", "0.01", "--out", str(out), "-q"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["run.npz"]
+
+
+def test_a_partial_file_of_a_running_process_is_left_alone(tmp_path, capsys):
+    out = tmp_path / "run.csv"
+    live = tmp_path / f"run.csv.{os.getppid()}.partial"  # the test runner's parent: alive
+    live.write_text("time,id\n")
+    assert cli.main(["simulate", "slopes", "--duration", "0.01", "--out", str(out), "-q"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["run.csv", live.name])
