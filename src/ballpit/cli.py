@@ -174,7 +174,8 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("impacts", "all"),
         default="impacts",
         help="impacts (default): a row when a contact starts (a bounce, a collision, a landing), not "
-        "for each step it rests or rolls on; all: every contact of every step",
+        "for each step it rests or rolls on; all: every contact of every step, sleeping balls' resting "
+        "contacts included",
     )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
