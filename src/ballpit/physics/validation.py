@@ -16,9 +16,10 @@ MAX_SPEED = 1e9  # m/s
 MAX_SPIN = 1e9  # rad/s
 RADIUS_RANGE = (1e-9, 1e9)  # m
 MASS_RANGE = (1e-12, 1e12)  # kg
-# Any component of gravity (m/s²): 100,000 g, ten thousand times the Sun's surface gravity. Within it a
-# ball gains at most 1e6·dt m/s a step, so it reaches MAX_SPEED only after minutes of free fall.
-MAX_GRAVITY = 1e6
+# Any component of gravity (m/s²): the same bound as every other number (and as scene files' largest),
+# 1e8 g. Squares and products of it with the other bounded values stay far from overflow, and a ball
+# falling under it reaches MAX_SPEED within a second, after which a step refuses it by name.
+MAX_GRAVITY = 1e9
 # A Python int too large for a float (10**400) is named so, not shown: its repr may be thousands of digits.
 TOO_LARGE = "an integer too large for a float"
 UNIT_TOLERANCE = 1e-6  # how far a plane's normal, axes or orientation may be from unit length

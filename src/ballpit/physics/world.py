@@ -92,7 +92,7 @@ class World:
     @property
     def gravity(self) -> np.ndarray:
         """Gravity (m/s²), read-only: assign a whole vector to change it (each component at most
-        ``validation.MAX_GRAVITY``, 1e6 m/s², in size)."""
+        ``validation.MAX_GRAVITY``, 1e9 m/s², in size)."""
         view = self.model.gravity.view()
         view.flags.writeable = False
         return view

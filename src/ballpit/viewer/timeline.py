@@ -65,8 +65,11 @@ class Timeline:
         """One fixed step: the physics (recorded, ghosts alongside) or the next replay frame."""
         world = self.sim.world
         if self.replay is not None:
+            balls = len(world.spheres)
             if not self.replay.advance(dt):
                 self.sim.end_of_replay()
+            if len(world.spheres) != balls:  # the recording gained a ball here
+                self.sim.after_seek(None)
             return _no_contacts()
         contacts = world.step(dt)
         if self.history is not None:
