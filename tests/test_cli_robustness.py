@@ -112,3 +112,64 @@ def test_a_partial_file_of_a_running_process_is_left_alone(tmp_path, capsys):
     live.write_text("time,id\n")
     assert cli.main(["simulate", "slopes", "--duration", "0.01", "--out", str(out), "-q"]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["run.csv", live.name])
+
+
+def _ballpit(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "ballpit", *args], cwd=ROOT, capture_output=True, text=True, timeout=timeout
+    )
+
+
+def _one_line_error(r: subprocess.CompletedProcess, *fragments: str) -> None:
+    assert r.returncode == 2, (r.returncode, r.stderr[-2000:])
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr[-2000:]
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+@pytest.mark.parametrize(
+    ("out", "duration", "fragments"),
+    [
+        ("demo.gif", "1e308", ["1e+308 s at 30 fps is inf frames", "the limit is 100,000"]),
+        ("frames/", "1e308", ["is inf frames"]),
+        ("demo.gif", "60", ["1,800 frames of 960x540", "at most 1,035 at this size", "PNG frames"]),
+    ],
+)
+def test_a_render_longer_than_its_output_can_take_is_refused_before_any_frame(
+    tmp_path, out, duration, fragments
+):
+    r = _ballpit("render", "slopes", "--out", str(tmp_path / out), "--duration", duration, timeout=60)
+    _one_line_error(r, *fragments)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_render_to_a_place_that_cannot_be_written_is_refused_before_any_frame():
+    r = _ballpit("render", "slopes", "--out", "/proc/ballpit-demo.gif", "--duration", "0.1", timeout=60)
+    _one_line_error(r, "/proc/ballpit-demo.gif: --out: cannot write in '/proc'")
+
+
+@pytest.mark.parametrize(
+    ("plot", "fragment"),
+    [
+        ("{tmp}", "--plot must end in .png, .svg or .pdf, not 'no suffix'"),
+        ("{tmp}/missing/plot.png", "--plot: directory '{tmp}/missing' does not exist"),
+        ("{tmp}/plot.xyz", "--plot must end in .png, .svg or .pdf, not '.xyz'"),
+    ],
+)
+def test_bench_refuses_a_bad_plot_path_before_measuring(tmp_path, capsys, plot, fragment):
+    plot, fragment = (s.replace("{tmp}", str(tmp_path)) for s in (plot, fragment))
+    status = cli.main(["bench", "--workload", "slopes", "--steps", "1", "--plot", plot])
+    captured = capsys.readouterr()
+    assert status == 2
+    assert captured.out == ""  # not even the table's header: nothing was measured
+    assert captured.err.strip().splitlines() == [f"ballpit bench: {plot}: {fragment}"]
+
+
+def test_bench_refuses_a_timeout_too_long_for_the_clock(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["bench", "--workload", "slopes", "--timeout", "1e308"])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2
+    assert "argument --timeout: must be at most 1e+06 seconds, got '1e308'" in err
+    assert len(err.strip().splitlines()) == 1

@@ -12,6 +12,7 @@ import math
 import os
 import signal
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
@@ -434,7 +435,7 @@ def _view(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
-    from .writers import OutputError, check_name_lengths
+    from .writers import OutputError, OutputFailed, check_name_lengths
 
     path = resolve_scene_path(args.scene)
     duration = args.duration or _load(str(path)).duration or 10.0
@@ -447,14 +448,23 @@ def _render(args: argparse.Namespace) -> int:
         )
     _check_render_path(out, args.out, folder)
     try:
-        from .viewer.render import render
+        from .viewer.render import frame_count, render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
+    kind = "frames" if folder else out.suffix.lower()[1:]
+    try:
+        frame_count(duration, args.fps, args.size, kind)
+    except ValueError as e:
+        raise UsageError(f"render --duration {duration:g}: {e}") from None
     created = _missing_folders(out if folder else out.parent)
     before = _render_files(out, folder)
     try:
+        _check_writable(out if folder else out.parent, args.out)
         written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    except OSError as e:  # the disk filled, or the file could not be made at the end
+        _remove_render_output(out, folder, before, created)
+        raise OutputFailed(f"{args.out}: cannot write: {e.strerror or e}") from None
     except BaseException:  # interrupted, stopped or failed: no frames or half-written file from this run
         _remove_render_output(out, folder, before, created)
         raise
@@ -474,6 +484,17 @@ def _check_render_path(out: Path, raw: str, folder: bool) -> None:
                 break
     except OSError as e:
         raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
+
+
+def _check_writable(folder: Path, raw: str) -> None:
+    """OutputError, before any frame is drawn, unless ``folder`` can be made and a file written in it."""
+    from .writers import OutputError
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError as e:
+        raise OutputError(f"{raw}: --out: cannot write in {str(folder)!r}: {e.strerror or e}") from None
 
 
 def _missing_folders(folder: Path) -> list[Path]:
