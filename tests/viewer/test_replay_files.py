@@ -209,3 +209,18 @@ def test_replay_seek_outside_the_added_balls_keeps_the_scene_balls(tmp_path):
         r.seek(frame)
         assert len(world.spheres) == t.balls_at(frame)
         np.testing.assert_array_equal(world.spheres.positions, t.position[frame, : t.balls_at(frame)])
+
+
+def test_csv_rows_that_never_end_stop_at_the_size_limit(monkeypatch):
+    """A CSV that keeps growing while it is read (a run still writing it) is read no further than the
+    limit: here an endless stream of rows against a limit of 1 MiB."""
+    import itertools
+
+    monkeypatch.setattr(replay_module, "MAX_BYTES", 1 << 20)
+    row = ",".join(["0"] * len(TRAJECTORY_COLUMNS)) + "\n"
+    lines = replay_module._capped_lines(itertools.repeat(row), 1 << 20)
+    read = 0
+    with pytest.raises(replay_module.InputRefused, match=r"more than a trajectory may have \(1 MiB\)"):
+        for line in lines:
+            read += len(line)
+    assert read <= 1 << 20
