@@ -2,21 +2,29 @@
 
 from __future__ import annotations
 
+import importlib
 from typing import TYPE_CHECKING
-
-from .physics import Contacts, Plane, Sphere, World
 
 __version__ = "0.1.0"
 __all__ = ["Contacts", "Plane", "Sphere", "World", "__version__", "load_scene"]
 
 if TYPE_CHECKING:
+    from .physics import Contacts, Plane, Sphere, World
     from .scene import load_scene
+
+# Imported on first use, so `import ballpit` (and with it the command line, which installs its Ctrl+C
+# and SIGTERM handlers first thing) starts before NumPy is loaded.
+_LAZY = {"Contacts": "physics", "Plane": "physics", "Sphere": "physics", "World": "physics",
+         "load_scene": "scene"}  # fmt: skip
 
 
 def __getattr__(name: str):
-    # The scene loader is imported on first use so `import ballpit` stays light.
-    if name == "load_scene":
-        from .scene import load_scene
-
-        return load_scene
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'ballpit' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -22,6 +22,7 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -240,6 +241,16 @@ def _plot(results: list[Result], path: str) -> None:
     print(f"wrote {path}")
 
 
+MAX_TIMEOUT = 1e6  # s (11.6 days): the wait for a child is kept in int milliseconds (at most 24.8 days)
+
+
+def _timeout(text: str) -> float:
+    seconds = positive(text)
+    if seconds > MAX_TIMEOUT:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_TIMEOUT:g} seconds, got {text!r}")
+    return seconds
+
+
 def _sizes(text: str) -> list[int]:
     try:
         sizes = [int(s) for s in text.split(",") if s.strip()]
@@ -273,7 +284,7 @@ def main(argv: list[str] | None = None) -> int:
         help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
     )
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
-    parser.add_argument("--timeout", type=positive, default=1800.0, help="seconds allowed per measurement")
+    parser.add_argument("--timeout", type=_timeout, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )
@@ -287,6 +298,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.pybullet and importlib.util.find_spec("pybullet") is None:
         print("ballpit bench: --pybullet needs PyBullet: pip install 'ballpit[bench]'", file=sys.stderr)
         return 2
+    if args.plot:  # a bad path is one line now, before the measurements
+        from .plots import PlotFile
+        from .writers import OutputError
+
+        try:
+            PlotFile(Path(args.plot)).discard()
+        except OutputError as e:
+            print(f"ballpit bench: {one_line(str(e))}", file=sys.stderr)
+            return 2
 
     plan = []
     if args.workload in ("free", "all"):

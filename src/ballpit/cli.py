@@ -11,6 +11,7 @@ import argparse
 import os
 import signal
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,16 +22,16 @@ from .arguments import OneLineParser, one_line
 from .arguments import count as _count
 from .arguments import positive as _positive
 from .arguments import size as _size
-from .physics import INTEGRATOR_NAMES
-from .physics.integrators import INTEGRATORS
+
+# Nothing heavy above this line (``ballpit`` imports NumPy only on first use): ``main`` installs its
+# Ctrl+C and SIGTERM handlers before the physics, the scene reader or the viewer are imported.
 
 if TYPE_CHECKING:
     from .physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
-_LABELS = [integrator.label for integrator in INTEGRATORS.values()]
-_INTEGRATOR_LABELS = ", ".join(_LABELS[:-1]) + " and " + _LABELS[-1]  # "Euler, RK2, RK4 and ..."
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a tool cut off by `| head`
 
 
 class Terminated(BaseException):
@@ -84,6 +85,11 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
+    from .physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
+
+    labels = [integrator.label for integrator in INTEGRATORS.values()]
+    integrator_labels = ", ".join(labels[:-1]) + " and " + labels[-1]  # "Euler, RK2, RK4 and ..."
+
     parser = OneLineParser(
         prog="ballpit",
         description="Balls, slopes, spin and impacts: a physics sandbox with a viewer and a headless runner.",
@@ -124,7 +130,8 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("impacts", "all"),
         default="impacts",
         help="impacts (default): a row when a contact starts (a bounce, a collision, a landing), not "
-        "for each step it rests or rolls on; all: every contact of every step",
+        "for each step it rests or rolls on; all: every contact of every step, sleeping balls' resting "
+        "contacts included",
     )
     p.add_argument("--every", type=_count, default=1, metavar="K", help="record every K-th step (default 1)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
@@ -136,8 +143,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "compare",
-        help=f"run a scene under {_INTEGRATOR_LABELS} and compare energy drift and end positions",
-        description=f"Run the scene under {_INTEGRATOR_LABELS} (each from its initial state) and RK4 at "
+        help=f"run a scene under {integrator_labels} and compare energy drift and end positions",
+        description=f"Run the scene under {integrator_labels} (each from its initial state) and RK4 at "
         "a quarter of the step as a reference; print each one's total-energy drift and how far its balls "
         "end from the reference's.",
     )
@@ -168,7 +175,41 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status."""
+    """Run the command line; returns the exit status.
+
+    The stop handlers come first, so Ctrl+C or SIGTERM while the modules still import exits 130 or
+    143 with one line, never a traceback. A closed stdout (``| head``) ends the run quietly.
+    """
+    previous = _install_stop_handlers()
+    try:
+        status = _run(argv)
+        sys.stdout.flush()  # here, not at exit, so a closed pipe is caught below
+        return status
+    except KeyboardInterrupt:
+        print("ballpit: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Terminated as e:
+        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null, so the interpreter's last flush of what is left finds no closed pipe."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout replaced by something without a descriptor
+        pass
+
+
+def _run(argv: Sequence[str] | None) -> int:
     keep_freed_memory()
     args_list = list(sys.argv[1:] if argv is None else argv)
     if args_list and args_list[0] == "bench":
@@ -180,7 +221,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .scene import SceneError
     from .writers import OutputError, OutputFailed
 
-    previous = _install_stop_handlers()
     try:
         return int(args.handler(args) or EXIT_OK)
     except (SceneError, OutputError, UsageError) as e:
@@ -189,15 +229,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OutputFailed as e:
         print(f"ballpit: {one_line(str(e))}; nothing was written", file=sys.stderr)
         return EXIT_FAILED
-    except KeyboardInterrupt:
-        print("ballpit: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Terminated as e:
-        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
 
 
 def _looks_like_scene(arg: str) -> bool:
@@ -241,7 +272,7 @@ class StepTotals:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from .simulate import MAX_STEPS, format_summary, run, step_count
+    from .simulate import MAX_STEPS, format_summary, run, step_count, step_longer_than_run
     from .writers import EventWriter, OutputError, TrajectoryWriter
 
     info = _load(args.scene)
@@ -250,8 +281,11 @@ def _simulate(args: argparse.Namespace) -> int:
         world.integrator = args.integrator
     dt = args.dt or info.timestep
     duration = args.duration or info.duration or 10.0
+    source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
+    too_long = step_longer_than_run(duration, dt)
+    if too_long:
+        raise UsageError(f"{source}: {too_long}")
     if not step_count(duration, dt) <= MAX_STEPS:
-        source = f"--dt {args.dt:g}" if args.dt else f"{info.path}: timestep {dt:g} s"
         raise UsageError(
             f"{source}: {duration:g} s in steps of {dt:g} s is {step_count(duration, dt):.3g} steps; "
             f"the limit is {MAX_STEPS:.0e} (use a larger step or a shorter --duration)"
@@ -356,7 +390,7 @@ def _view(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from .scene import resolve_scene_path
-    from .writers import OutputError, check_name_lengths
+    from .writers import OutputError, OutputFailed, check_name_lengths
 
     path = resolve_scene_path(args.scene)
     duration = args.duration or _load(str(path)).duration or 10.0
@@ -369,14 +403,23 @@ def _render(args: argparse.Namespace) -> int:
         )
     _check_render_path(out, args.out, folder)
     try:
-        from .viewer.render import render
+        from .viewer.render import frame_count, render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
+    kind = "frames" if folder else out.suffix.lower()[1:]
+    try:
+        frame_count(duration, args.fps, args.size, kind)
+    except ValueError as e:
+        raise UsageError(f"render --duration {duration:g}: {e}") from None
     created = _missing_folders(out if folder else out.parent)
     before = _render_files(out, folder)
     try:
+        _check_writable(out if folder else out.parent, args.out)
         written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+    except OSError as e:  # the disk filled, or the file could not be made at the end
+        _remove_render_output(out, folder, before, created)
+        raise OutputFailed(f"{args.out}: cannot write: {e.strerror or e}") from None
     except BaseException:  # interrupted, stopped or failed: no frames or half-written file from this run
         _remove_render_output(out, folder, before, created)
         raise
@@ -396,6 +439,17 @@ def _check_render_path(out: Path, raw: str, folder: bool) -> None:
                 break
     except OSError as e:
         raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
+
+
+def _check_writable(folder: Path, raw: str) -> None:
+    """OutputError, before any frame is drawn, unless ``folder`` can be made and a file written in it."""
+    from .writers import OutputError
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError as e:
+        raise OutputError(f"{raw}: --out: cannot write in {str(folder)!r}: {e.strerror or e}") from None
 
 
 def _missing_folders(folder: Path) -> list[Path]:

@@ -21,7 +21,7 @@ from tqdm import tqdm
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .physics import World
 from .physics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
-from .simulate import progress_bar, step_plan
+from .simulate import progress_bar, step_longer_than_run, step_plan
 
 INTEGRATORS = INTEGRATOR_NAMES
 REFERENCE_INTEGRATOR = DEFAULT_INTEGRATOR
@@ -227,6 +227,10 @@ def main(args: argparse.Namespace) -> int:
     scene = open_scene(args.scene)
     dt = args.dt or scene.timestep
     duration = args.duration or scene.duration or DEFAULT_DURATION
+    too_long = step_longer_than_run(duration, dt)
+    if too_long:
+        print(f"ballpit: {scene.name}: {too_long}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     plot = PlotFile(args.plot) if args.plot is not None else None
     try:
         try:

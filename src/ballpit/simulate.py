@@ -107,6 +107,34 @@ class ImpactFilter:
         return Contacts(**{f.name: getattr(contacts, f.name)[~seen] for f in fields(Contacts)})
 
 
+class SleepingContacts:
+    """Adds, to each step's contacts, those of sleeping balls (``events_kind="all"``).
+
+    A sleeping ball still rests on what it fell asleep on, but the step no longer solves that contact
+    (it holds the ball still instead), so the step does not report it. Here each pair whose balls are
+    all asleep now carries on the last contact solved for it: the same point, normal and impulse (the
+    impulse that held it each step while awake), at each later step's start time.
+    """
+
+    def __init__(self) -> None:
+        self._last = Contacts.empty()  # what the last step reported, carried rows included
+
+    def __call__(self, world: World, contacts: Contacts, start: float) -> Contacts:
+        """``contacts`` of the step that began at ``start``, with the sleeping balls' resting ones."""
+        last = self._last
+        if len(last):
+            asleep = world.asleep
+            held = asleep[last.a] & np.where(last.kind == SPHERE_SPHERE, asleep[last.b], True)
+            if len(contacts) and held.any():
+                held &= ~np.isin(_pair_keys(last), _pair_keys(contacts))
+            if held.any():
+                carried = Contacts(**{f.name: getattr(last, f.name)[held] for f in fields(Contacts)})
+                carried.time[:] = start
+                contacts = Contacts.concatenate([contacts, carried])
+        self._last = contacts
+        return contacts
+
+
 def _pair_keys(contacts: Contacts) -> np.ndarray:
     """One integer per (kind, a, b) pair (ball and plane indices are below 2**30)."""
     return ((contacts.a.astype(np.int64) * 2 + contacts.kind) << 32) | contacts.b.astype(np.int64)
@@ -125,9 +153,20 @@ def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
     whole = math.floor(duration / dt + 1e-9)
     rest = duration - whole * dt
     plan = [(whole, dt)] if whole else []
-    if rest > 1e-9 * dt:
+    if rest > 1e-9 * min(dt, duration):  # a step longer than the run: one step of the whole run
         plan.append((1, rest))
     return plan
+
+
+def step_longer_than_run(duration: float, dt: float) -> str | None:
+    """What is wrong when a step of ``dt`` is longer than the whole run (the command line refuses it:
+    the run would be one step of ``duration`` instead), else None."""
+    if dt <= duration * (1 + 1e-9):
+        return None
+    return (
+        f"a step of {dt:g} s is longer than the run ({duration:g} s): "
+        "use a smaller --dt or a longer --duration"
+    )
 
 
 def progress_bar(total: int, name: str, progress: bool) -> tqdm:
@@ -160,17 +199,20 @@ def run(
 
     ``dt`` defaults to the physics' default timestep; ``name`` labels the progress bar. The trajectory
     gets the initial state, every ``every``-th step and the final state. ``events`` gets the impacts
-    (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step. The writers are
+    (see ImpactFilter) or, with ``events_kind="all"``, every contact of every step, sleeping balls'
+    resting contacts included (see SleepingContacts). The writers are
     not committed here; the caller commits them on success or discards them on failure.
     """
     if events_kind not in EVENT_KINDS:
         raise ValueError(f"events_kind must be one of {', '.join(EVENT_KINDS)}, got {events_kind!r}")
     keep = ImpactFilter() if events is not None and events_kind == "impacts" else None
+    sleeping = SleepingContacts() if events is not None and events_kind == "all" else None
     dt = dt if dt is not None else DEFAULT_TIMESTEP
     plan = step_plan(duration, dt)
     total = sum(n for n, _ in plan)
     balls = world.spheres
     start_energy = energy(world)
+    start_time = world.time
 
     def record() -> None:
         if trajectory is not None:
@@ -188,11 +230,14 @@ def run(
     try:
         for n, h in plan:
             for _ in range(n):
+                began_at = world.time
                 contacts = world.step(h)
                 done += 1
                 if len(contacts):
                     counts += np.bincount(contacts.kind, minlength=2)[:2]
                 if events is not None:
+                    if sleeping is not None and world.sleep:
+                        contacts = sleeping(world, contacts, began_at)
                     events.add(contacts if keep is None else keep(contacts))
                 if done % every == 0 or done == total:
                     record()
@@ -204,7 +249,7 @@ def run(
     wall = clock.perf_counter() - began
     return RunSummary(
         steps=done,
-        sim_time=duration,
+        sim_time=world.time - start_time,  # what was stepped, so an interrupted or odd plan says so
         wall_time=wall,
         sphere_plane_contacts=int(counts[SPHERE_PLANE]),
         sphere_sphere_contacts=int(counts[SPHERE_SPHERE]),

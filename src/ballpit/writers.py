@@ -1,7 +1,9 @@
 """Trajectory and contact-event writers (CSV or NPZ), complete or not at all.
 
-Each writer fills a temporary file beside its target and renames it into place only when the run
-finishes, so a crash, a Ctrl+C or a bad option never leaves a truncated file that looks complete.
+Each writer fills a temporary file beside its target (``run.npz.<pid>.partial``) and renames it into
+place only when the run finishes, so a crash, a Ctrl+C or a bad option never leaves a truncated file
+that looks complete. A process killed outright (SIGKILL, a power cut) cannot remove its temporary file;
+it is left in plain sight, named as unfinished, and the next write to the same target removes it.
 Rows are buffered as arrays a chunk at a time and streamed to disk as the run goes, so memory does not
 grow with the duration: CSV text is formatted a chunk at a time with one ``%`` operation, not per row;
 for ``.npz``, each chunk's columns go to an unnamed scratch file, and ``commit`` copies them column by
@@ -48,7 +50,7 @@ def _writing(path: Path) -> Iterator[None]:
 
 
 NAME_MAX = 255  # bytes in one file name on Linux, macOS and Windows file systems
-_TEMP_NAME = ".{name}.{pid}.partial"
+_TEMP_NAME = "{name}.{pid}.partial"  # visible: one left by a killed run is plainly unfinished
 
 
 def shorten(path: Path | str, limit: int = 80) -> str:
@@ -84,12 +86,51 @@ def check_output_path(path: Path, what: str) -> str:
     return suffix
 
 
-def temp_path(target: Path) -> Path:
-    """A hidden temporary name beside ``target`` (its name shortened if need be to fit NAME_MAX)."""
-    name, pid = target.name, os.getpid()
+def temp_path(target: Path, pid: int | None = None) -> Path:
+    """The temporary name beside ``target`` for process ``pid`` (this one by default), its name
+    shortened if need be to fit NAME_MAX."""
+    name, pid = target.name, os.getpid() if pid is None else pid
     while len(os.fsencode(_TEMP_NAME.format(name=name, pid=pid))) > NAME_MAX:
         name = name[:-1]
     return target.with_name(_TEMP_NAME.format(name=name, pid=pid))
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    except (OverflowError, ValueError):  # too large to be a process id
+        return False
+    return True
+
+
+def remove_stale_temps(target: Path) -> list[Path]:
+    """Remove the temporary files of ``target`` left by runs that were killed outright (their
+    process is gone); returns them. Older runs hid theirs (a leading dot): those go too."""
+    removed = []
+    try:
+        entries = list(os.scandir(_directory(target)))
+    except OSError:
+        return removed
+    for entry in entries:
+        name = entry.name
+        if not name.endswith(".partial"):
+            continue
+        pid_text = name.removesuffix(".partial").rpartition(".")[2]
+        if not pid_text.isdigit() or int(pid_text) == os.getpid():
+            continue
+        pid = int(pid_text)
+        if name.removeprefix(".") != temp_path(target, pid).name or _running(pid):
+            continue
+        try:
+            os.unlink(entry.path)
+            removed.append(Path(entry.path))
+        except OSError:
+            pass
+    return removed
 
 
 class AtomicFile:
@@ -98,6 +139,7 @@ class AtomicFile:
     def __init__(self, target: Path, mode: str = "w") -> None:
         self.target = target
         self.temp = temp_path(target)
+        remove_stale_temps(target)
         try:
             self.file: IO = open(self.temp, mode, encoding="utf-8" if "b" not in mode else None)
         except OSError as e:

@@ -164,3 +164,38 @@ def test_an_untouched_scene_saves_its_grid_as_a_grid(tmp_path):
     text = saved.read_text()
     assert "[[grid]]" in text and text.count("[[sphere]]") == 1
     assert_same_world(ballpit.load_scene(saved), sim.world)
+
+
+def test_a_state_whose_balls_press_into_each_other_and_the_floor_saves_and_loads(tmp_path):
+    """Balls at rest overlap a little (about 4e-5 m between pile.toml's 10 cm balls after 3 s), more
+    than a scene's start allows by default (1e-6 m): the saved file allows what it holds, and loads."""
+    path = tmp_path / "pair.toml"
+    path.write_text("[[plane]]\nnormal = [0, 1, 0]\n\n[[sphere]]\nposition = [0, 0.1, 0]\nradius = 0.1\n"
+                    "\n[[sphere]]\nposition = [1, 0.1, 0]\nradius = 0.1\n")  # fmt: skip
+    sim = Simulation(read_scene(path), path)
+    world = sim.world
+    world.spheres[0].position = (0.0, 0.1 - 1e-5, 0.0)  # 1e-5 m into the floor
+    world.spheres[1].position = (0.2 - 4e-5, 0.1, 0.0)  # 4e-5 m into ball 0
+    saved = save_scene(sim, Camera.looking_at((0.0, 1.0, 3.0), (0.0, 0.0, 0.0)))
+    loaded = read_scene(saved).world
+    assert np.array_equal(loaded.spheres.positions, world.spheres.positions)
+    assert "overlap_tolerance = 8e-05" in saved.read_text()  # twice the deepest, 4e-5 m
+    with pytest.raises(ballpit.scene.SceneError, match=r"overlaps|cuts into"):
+        read_scene(path.parent / _without_tolerance(saved))
+
+
+def _without_tolerance(saved):
+    """The saved file without its overlap_tolerance line: a hand-written start with these overlaps."""
+    strict = saved.with_name("strict.toml")
+    strict.write_text(
+        "".join(ln for ln in saved.read_text().splitlines(True) if "overlap_tolerance" not in ln)
+    )
+    return strict.name
+
+
+def test_an_untouched_scene_is_saved_without_an_overlap_tolerance(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(read_scene(path), path)
+    saved = save_scene(sim, Camera.looking_at((1.0, 2.0, 8.0), (0.0, 1.0, 0.0)))
+    assert "overlap_tolerance" not in saved.read_text()

@@ -8,6 +8,7 @@ hand out whole columns (``world.spheres.positions``) for code that works on ever
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Iterator, Sequence
 from typing import Protocol, overload
 
@@ -240,7 +241,10 @@ class _Views(Sequence):
         n = self._count()
         if isinstance(i, slice):
             return [self._view(self._world, k) for k in range(n)[i]]
-        k = int(i)
+        try:
+            k = operator.index(i)  # ints and NumPy integers; 1.5, "0" and True-like floats are refused
+        except TypeError:
+            raise TypeError(f"indices must be integers or slices, not {type(i).__name__} ({i!r})") from None
         if k < 0:
             k += n
         if not 0 <= k < n:

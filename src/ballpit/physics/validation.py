@@ -16,6 +16,13 @@ MAX_SPEED = 1e9  # m/s
 MAX_SPIN = 1e9  # rad/s
 RADIUS_RANGE = (1e-9, 1e9)  # m
 MASS_RANGE = (1e-12, 1e12)  # kg
+# Any component of gravity (m/s²): the same bound as every other number (and as scene files' largest),
+# 1e8 g. Squares and products of it with the other bounded values stay far from overflow, and a ball
+# falling under it reaches MAX_SPEED within a second, after which a step refuses it by name.
+MAX_GRAVITY = 1e9
+# A Python int too large for a float (10**400) is named so, not shown: its repr may be thousands of digits.
+TOO_LARGE = "an integer too large for a float"
+UNIT_TOLERANCE = 1e-6  # how far a plane's normal, axes or orientation may be from unit length
 
 
 def vector(name: str, value: object, length: int = 3, limit: float = math.inf) -> np.ndarray:
@@ -25,6 +32,8 @@ def vector(name: str, value: object, length: int = 3, limit: float = math.inf) -
         raise TypeError(f"{name} must be a sequence of {length} numbers, got {value!r}")
     try:
         arr = np.array(value, dtype=float)
+    except OverflowError:  # a Python int beyond float range, 10**400
+        raise ValueError(f"{name} must be finite, got {TOO_LARGE}") from None
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a sequence of {length} numbers, got {value!r}") from None
     if arr.shape != (length,):
@@ -48,7 +57,10 @@ def number(
     """A finite float (or ±inf if ``infinite``; never NaN), optionally > 0, ≥ 0 or ``within`` a range."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise TypeError(f"{name} must be a number, got {value!r}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:  # a Python int beyond float range, 10**400
+        raise ValueError(f"{name} must be finite, got {TOO_LARGE}") from None
     if math.isnan(x) or (math.isinf(x) and not infinite):
         raise ValueError(f"{name} must be finite, got {value!r}")
     if positive and x <= 0.0:
@@ -98,7 +110,10 @@ def plane_size(name: str, value: object) -> tuple[float, float]:
 def _extent(name: str, v: object, whole: object) -> float:
     if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
         raise TypeError(f"{name} must be a number or [width, depth], got {whole!r}")
-    x = float(v)
+    try:
+        x = float(v)
+    except OverflowError:  # a Python int beyond float range, 10**400
+        raise ValueError(f"{name} must be finite or inf, got {TOO_LARGE}") from None
     if math.isnan(x) or x <= 0.0:
         raise ValueError(f"{name} must be positive, got {whole!r}")
     return x
@@ -109,6 +124,8 @@ def array_of(name: str, value: object, count: int, width: int | None,
     """Broadcast a batch argument to (count,) or (count, width) floats, all finite and ``within``."""
     try:
         arr = np.asarray(value, dtype=float)
+    except OverflowError:  # a Python int beyond float range, 10**400
+        raise ValueError(f"{name} must be finite, got {TOO_LARGE}") from None
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be numeric, got {value!r}") from None
     shape = (count,) if width is None else (count, width)
@@ -241,3 +258,81 @@ def plane(position, normal, rotation, size, restitution, friction, rolling_frict
         "angular_velocity": vector("angular_velocity", angular_velocity, limit=MAX_SPIN),
     }
     return center, q, extent, materials, motion
+
+
+# The plane columns a user can write through ``world.planes`` (its columns, or a plane's vectors), what
+# each must hold, and where it lives ("pose": state.planes, moved by a step; "shape": model.planes).
+# Kinds: "bounded" |x| <= limit, "unit" rows of length 1, "extent" positive (inf: unbounded),
+# "material" finite and not negative.
+_PLANE_FIELDS = (
+    ("center", "pose", "bounded", MAX_COORDINATE),
+    ("orientation", "pose", "unit", None),
+    ("normal", "pose", "unit", None),
+    ("axis_u", "pose", "unit", None),
+    ("axis_v", "pose", "unit", None),
+    ("velocity", "shape", "bounded", MAX_SPEED),
+    ("angular_velocity", "shape", "bounded", MAX_SPIN),
+    ("half_size", "shape", "extent", None),
+    ("restitution", "shape", "material", None),
+    ("friction", "shape", "material", None),
+    ("rolling_friction", "shape", "material", None),
+)
+_PLANE_RULES = {
+    "bounded": "must be finite and at most {limit:g} in size",
+    "unit": "must be a unit vector",
+    "extent": "must be positive (inf: unbounded)",
+    "material": "must be finite and not negative",
+}
+
+
+def _bad_plane_values(kind: str, arr: np.ndarray, limit: float | None) -> np.ndarray:
+    """A mask of the entries of ``arr`` that a step cannot use (NaN fails every comparison)."""
+    if kind == "bounded":
+        return ~(np.abs(arr) <= limit)
+    if kind == "unit":
+        length = np.sqrt(np.sum(arr * arr, axis=1, keepdims=True))
+        return np.broadcast_to(~(np.abs(length - 1.0) <= UNIT_TOLERANCE), arr.shape)
+    if kind == "extent":
+        return ~(arr > 0.0)
+    return ~((arr >= 0.0) & (arr < math.inf))
+
+
+def plane_columns(shape, pose) -> list[np.ndarray]:
+    """The live plane columns ``reject_bad_planes`` checks (``shape``/``pose``: the model's and the
+    state's plane Columns), in its order."""
+    n = shape.count  # every step looks: full(name)[:n] costs a third of Columns.__getattr__
+    return [(pose if where == "pose" else shape).full(name)[:n] for name, where, _, _ in _PLANE_FIELDS]
+
+
+def planes_as_stepped(shape, pose) -> np.ndarray:
+    """Every checked plane column, flattened into one copy: what ``reject_bad_planes`` compares with."""
+    return np.concatenate([c.ravel() for c in plane_columns(shape, pose)])
+
+
+def reject_bad_planes(shape, pose, good: np.ndarray | None) -> np.ndarray:
+    """Refuse to step with a NaN, inf or out-of-range value written into a plane (a ``world.planes``
+    column or a plane's vector): ValueError naming the plane, the field and the value. ``good`` is
+    ``planes_as_stepped`` after the last step: when nothing differs from it there is nothing to check
+    (the common case costs one copy and one comparison); every bad entry is put back as it was there,
+    so the world keeps its last good state. Returns the columns checked, flattened."""
+    columns = plane_columns(shape, pose)
+    now = np.concatenate([c.ravel() for c in columns])
+    if good is not None and good.shape == now.shape and (now == good).all():
+        return now
+    restorable = good is not None and good.shape == now.shape
+    first, at = None, 0
+    for arr, (name, _, kind, limit) in zip(columns, _PLANE_FIELDS, strict=True):
+        before = good[at : at + arr.size].reshape(arr.shape) if restorable else None
+        at += arr.size
+        bad = _bad_plane_values(kind, arr, limit)
+        if not bad.any():
+            continue
+        if first is None:
+            row = int(np.argwhere(bad)[0][0])
+            rule = _PLANE_RULES[kind].format(limit=limit)
+            first = f"plane #{row} has a bad {name} {arr[row].tolist()}: it {rule}"
+        if before is not None:
+            arr[bad] = before[bad]
+    if first is not None:
+        raise ValueError(f"{first}; the world was not stepped and keeps its last good state")
+    return now

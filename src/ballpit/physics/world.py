@@ -77,6 +77,7 @@ class World:
         self._pairs = PairCache()
         self._warm = WarmStart()
         self._workspace = Workspace()
+        self._good_planes: np.ndarray | None = None  # the plane columns after the last step (validation.py)
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -90,11 +91,15 @@ class World:
 
     @property
     def gravity(self) -> np.ndarray:
-        return self.model.gravity
+        """Gravity (m/s²), read-only: assign a whole vector to change it (each component at most
+        ``validation.MAX_GRAVITY``, 1e9 m/s², in size)."""
+        view = self.model.gravity.view()
+        view.flags.writeable = False
+        return view
 
     @gravity.setter
     def gravity(self, value: object) -> None:
-        self.model.gravity = validation.vector("gravity", value)
+        self.model.gravity = validation.vector("gravity", value, limit=validation.MAX_GRAVITY)
 
     @property
     def integrator(self) -> str:
@@ -264,7 +269,12 @@ class World:
         pose.reserve(1)
         pose.full("center")[i] = center
         moving_planes.set_orientation(pose, i, q)
+        self._remember_planes()
         return Plane(self, i)
+
+    def _remember_planes(self) -> None:
+        """Copy the plane columns, to put back a bad value written into them before the next step."""
+        self._good_planes = validation.planes_as_stepped(self.model.planes, self.state.planes)
 
     # ------------------------------------------------------------------ stepping
     def forces(self) -> list[ForceTerm]:
@@ -284,6 +294,7 @@ class World:
         began = perf_counter()
         model, state = self.model, self.state
         validation.reject_unsteppable_state(state.body)
+        planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
                                model.bounce_threshold(dt), EventLog(), StepProfile())  # fmt: skip
@@ -324,6 +335,10 @@ class World:
             with prof.stage("sleep"):
                 sleeping.after_step(model, state, sleep, contacts, reach, dt)
         validation.undo_non_finite_step(state.body, before)
+        if model.moving_planes():  # else the step left them as they were checked
+            self._remember_planes()
+        else:
+            self._good_planes = planes
         state.time += dt
         record = step.events.record()
         prof.pairs, prof.contacts, prof.crowded = len(pairs), len(record), crowd is not None
@@ -364,6 +379,7 @@ class World:
             (snap.model, snap.state, snap.pairs, snap.warm)
         )
         self.crowded_steps = snap.crowded_steps
+        self._remember_planes()
 
     def copy(self) -> World:
         """An independent World in the same state (it steps on exactly as this one would)."""

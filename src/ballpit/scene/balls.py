@@ -90,9 +90,14 @@ class Balls:
         ]
         return np.concatenate(out) if out else np.zeros((0, 3))
 
-    def check_overlaps(self, positions: np.ndarray, radii: np.ndarray, world: World) -> None:
-        """Refuse balls that interpenetrate each other or a plane at the start."""
-        tolerance = schema.OVERLAP_TOLERANCE
+    def check_overlaps(
+        self,
+        positions: np.ndarray,
+        radii: np.ndarray,
+        world: World,
+        tolerance: float = schema.OVERLAP_TOLERANCE,
+    ) -> None:
+        """Refuse balls that interpenetrate each other or a plane by more than ``tolerance`` at the start."""
         pair = first_overlap(positions, radii, tolerance)
         if pair is not None:
             i, j = pair

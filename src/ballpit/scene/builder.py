@@ -47,7 +47,7 @@ class Builder:
         if balls.count:
             positions = np.concatenate(balls.positions)
             columns = {k: balls.column(k) for k in schema.BALL_COLUMNS}
-            balls.check_overlaps(positions, columns["radius"], world)
+            balls.check_overlaps(positions, columns["radius"], world, self.overlap_tolerance)
             columns["hollow"] = columns["hollow"].astype(bool)
             world.add_spheres(positions, **columns)
         position, look_at = self.camera(camera, *given, world)
@@ -78,6 +78,7 @@ class Builder:
             ),
             sleep=e.boolean("sleep", bool(d["sleep"])),
         )
+        self.overlap_tolerance = e.number("overlap_tolerance", schema.OVERLAP_TOLERANCE, nonnegative=True)
         return params, timestep, e.number("duration", None, positive=True)
 
     @staticmethod
@@ -256,6 +257,12 @@ class Builder:
         if far > LARGEST:
             key = "spacing" if "spacing" in e.data else "count"
             raise e.error(key, f"the block reaches {far:.4g} m from the origin, beyond 1e9 m")
+        fastest = float(np.abs(props["velocity"]).max()) + velocity_jitter
+        if fastest > LARGEST:
+            key = "velocity_jitter" if velocity_jitter > 0 else "velocity"
+            raise e.error(
+                key, f"a ball's velocity could reach {fastest:.4g} m/s along an axis, beyond 1e9 m/s"
+            )
         positions = layout.grid_positions(count, spacing, corner, center)
         positions, props["velocity"] = layout.jitter(
             positions, props["velocity"], jitter, velocity_jitter, seed

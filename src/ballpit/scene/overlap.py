@@ -87,3 +87,24 @@ def first_plane_cut(
             k = int(inside[0])
             return p, k, float(dist[k])
     return None
+
+
+def deepest_overlap(positions: np.ndarray, radii: np.ndarray, planes: object) -> float:
+    """How far (m) the balls press into each other or into a plane at most now; 0 when none do.
+
+    What a scene saved from a running world must allow at its start (``[world] overlap_tolerance``).
+    """
+    positions = np.asarray(positions, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    if len(positions) == 0:
+        return 0.0
+    deepest = 0.0
+    if len(positions) > 1:
+        reach = radii[:, None]
+        i, j = sphere_pairs(positions - reach, positions + reach)
+        if len(i):
+            d = np.linalg.norm(positions[i] - positions[j], axis=1)
+            deepest = max(deepest, float((radii[i] + radii[j] - d).max()))
+    for plane in planes:  # type: ignore[attr-defined]
+        deepest = max(deepest, float((radii - np.asarray(plane.distance(positions))).max()))
+    return deepest

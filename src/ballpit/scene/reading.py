@@ -8,9 +8,10 @@ the file is ``lines.LineIndex``'s job.
 from __future__ import annotations
 
 import re
-import stat
 import tomllib
 from pathlib import Path
+
+from ..inputs import InputRefused, open_regular, read_capped
 
 SHOWN = 60  # characters: a value or key longer than this is shortened in messages, ending in …
 _NAMED = {"\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}
@@ -96,27 +97,16 @@ MAX_BYTES = 16 * 1024 * 1024  # a scene file larger than this is refused unread
 def read_text(path: Path) -> str:
     """The file as UTF-8 text; ``SceneError`` naming the reason when it cannot be read.
 
-    Only regular files up to ``MAX_BYTES`` are read, so a pipe, a device or a huge file can neither
-    block nor fill the memory.
+    Only regular files up to ``MAX_BYTES`` are read, opened so that a read cannot wait (inputs.py), so
+    a pipe, a device, a kernel file like /proc/kmsg or a huge file can neither block nor fill the memory.
     """
     try:
-        info = path.stat()
-        if stat.S_ISDIR(info.st_mode):
-            raise SceneError(path, "is a directory, not a scene file")
-        if not stat.S_ISREG(info.st_mode):
-            raise SceneError(path, "not a regular file (a pipe, device or socket)")
-        if info.st_size > MAX_BYTES:
-            raise SceneError(path, f"{info.st_size} bytes, more than a scene file may have (16 MiB)")
-        with path.open("rb") as f:
-            raw = f.read(MAX_BYTES + 1)
-    except FileNotFoundError:
-        raise SceneError(path, "no such file") from None
-    except PermissionError:
-        raise SceneError(path, "permission denied") from None
+        with open_regular(path, MAX_BYTES, "a scene file") as f:
+            raw = read_capped(f, MAX_BYTES, "a scene file")
+    except InputRefused as e:
+        raise SceneError(path, str(e)) from None
     except OSError as e:
         raise SceneError(path, f"cannot read: {e.strerror or e}") from None
-    if len(raw) > MAX_BYTES:  # it grew after the check
-        raise SceneError(path, "more bytes than a scene file may have (16 MiB)")
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as e:

@@ -56,12 +56,13 @@ class FrameFeeder:
             self.plane_uploads += 1
         positions, orientations = sim.render_state()
         spheres = world.spheres
-        self.renderer.upload_balls(positions, orientations, spheres.radii, look.sphere_colors, eye)
+        colors = look.sphere_colors[: len(positions)]  # a replay or the history may hold fewer balls now
+        self.renderer.upload_balls(positions, orientations, spheres.radii, colors, eye)
         self._upload_ghosts(sim)
 
         world_lines, overlay_lines = overlays.empty(), overlays.empty()
         if flags.trails and sim.trails.filled:
-            world_lines = overlays.trail_lines(sim.trails.ordered(), look.sphere_colors, positions)
+            world_lines = overlays.trail_lines(sim.trails.ordered(), colors, positions)
         parts = []
         if flags.contacts and sim.contacts is not None and len(sim.contacts):
             parts.append(overlays.contact_lines(sim.contacts.point, sim.contacts.normal))

@@ -21,6 +21,11 @@ from .camera import Camera
 from .simulation import Simulation
 
 OUTPUT_KINDS = "a .gif file, a .png file or a directory (ending in /) for PNG frames"
+# A GIF is written at the end from all its frames, which stay in memory until then (Pillow needs them
+# together): at most this many bytes of them (one byte a pixel), 34 s at 960x540 and 30 fps. PNG frames
+# go to disk one by one, at most MAX_FRAMES of them (55 min at 30 fps).
+MAX_GIF_BYTES = 512 << 20
+MAX_FRAMES = 100_000
 
 
 class Offscreen:
@@ -112,6 +117,26 @@ def _output_kind(out: Path, raw: str) -> str:
     raise ValueError(f"out must be {OUTPUT_KINDS}, got {raw!r}")
 
 
+def frame_count(duration: float, fps: float, size: tuple[int, int], kind: str) -> int:
+    """How many frames ``duration`` s at ``fps`` makes; ValueError when that is more than the output
+    ``kind`` ("gif", "png" or "frames") takes (see MAX_GIF_BYTES and MAX_FRAMES)."""
+    wanted = duration * fps
+    if not wanted <= MAX_FRAMES:  # inf and NaN too
+        raise ValueError(
+            f"{duration:g} s at {fps:g} fps is {wanted:.3g} frames; the limit is {MAX_FRAMES:,} "
+            f"({MAX_FRAMES / fps:.4g} s at {fps:g} fps)"
+        )
+    frames = max(1, round(wanted))
+    if kind == "gif" and frames * size[0] * size[1] > MAX_GIF_BYTES:
+        most = MAX_GIF_BYTES // (size[0] * size[1])
+        raise ValueError(
+            f"{duration:g} s at {fps:g} fps is {frames:,} frames of {size[0]}x{size[1]}; a GIF holds its "
+            f"frames in memory until written, at most {most:,} at this size ({most / fps:.3g} s): render "
+            "a shorter clip, a smaller --size or a lower --fps, or PNG frames into a folder"
+        )
+    return frames
+
+
 def _check(duration: float, fps: float, size: tuple[int, int]) -> tuple[int, int]:
     if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
@@ -159,7 +184,8 @@ def render_world(
     out = Path(out)
     kind = _output_kind(out, raw)
     width, height = _check(duration, fps, size)
-    frames = max(1, round(duration * fps))
+    frames = frame_count(duration, fps, (width, height), kind)
+    digits = max(4, len(str(frames - 1)))  # frame_0000.png ...: names sort in frame order
     if kind == "frames":
         out.mkdir(parents=True, exist_ok=True)
     else:
@@ -185,7 +211,7 @@ def render_world(
                     remaining -= chunk
             last = screen.render(sim, camera)
             if kind == "frames":
-                Image.fromarray(last).save(out / f"frame_{index:04d}.png")
+                Image.fromarray(last).save(out / f"frame_{index:0{digits}d}.png")
             elif kind == "gif":
                 if palette is None:
                     palette = gif_palette(last, look.sphere_colors)

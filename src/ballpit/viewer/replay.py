@@ -9,14 +9,18 @@ velocities, spins, orientations, time), so everything that reads the world draws
 from __future__ import annotations
 
 import bisect
+import io
+import math
 import warnings
 import zipfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ballpit.inputs import InputRefused, open_regular, size_text
 from ballpit.writers import TRAJECTORY_COLUMNS
 
 # stacked .npz arrays → (their width, the CSV column they start at)
@@ -32,10 +36,18 @@ class TrajectoryError(ValueError):
     """A trajectory that cannot be read or does not fit the scene."""
 
 
+# The most a trajectory may hold: 2 GiB of numbers (.npz members, uncompressed) or of CSV text, about
+# 18 million rows (1,000 balls for 75 s at every 1/240 s step; 'simulate --every K' writes less). Reading
+# one takes about twice that in memory. Anything beyond is refused before it is inflated or parsed.
+MAX_BYTES = 2 << 30
+
+
 @dataclass
 class Trajectory:
     """Frames of every ball's state: ``times`` (F,), ``position`` (F, N, 3), ``velocity`` (F, N, 3),
-    ``angular_velocity`` (F, N, 3), ``orientation`` (F, N, 4)."""
+    ``angular_velocity`` (F, N, 3), ``orientation`` (F, N, 4). ``counts`` (F,) is how many balls each
+    frame has: balls added during a recording (B in the viewer) get the next ids, so frame k holds
+    balls 0..counts[k]-1 (the rest of its rows are NaN); None when every frame has all N."""
 
     path: Path
     times: np.ndarray
@@ -43,6 +55,7 @@ class Trajectory:
     velocity: np.ndarray
     angular_velocity: np.ndarray
     orientation: np.ndarray
+    counts: np.ndarray | None = None
 
     @property
     def frames(self) -> int:
@@ -50,28 +63,75 @@ class Trajectory:
 
     @property
     def balls(self) -> int:
+        """The most balls any frame has."""
         return self.position.shape[1]
+
+    def balls_at(self, frame: int) -> int:
+        return self.balls if self.counts is None else int(self.counts[frame])
 
 
 def _columns_from_csv(path: Path) -> dict[str, np.ndarray]:
-    with path.open("r", encoding="utf-8") as f:
-        header = [name.strip() for name in f.readline().strip().split(",")]
+    with open_regular(path, MAX_BYTES, "a trajectory") as raw, io.TextIOWrapper(raw, encoding="utf-8") as f:
+        header_line = f.readline(64 * 1024)
+        header = [name.strip() for name in header_line.strip().split(",")]
         if header == [""]:
             raise TrajectoryError(f"{path}: empty file, not a trajectory")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # no rows: checked below, by name
-            data = np.loadtxt(f, delimiter=",", ndmin=2)
+            data = np.loadtxt(_capped_lines(f, MAX_BYTES - len(header_line)), delimiter=",", ndmin=2)
     if data.size and data.shape[1] != len(header):
         raise TrajectoryError(f"{path}: rows have {data.shape[1]} values but the header names {len(header)}")
     data = data.reshape(-1, len(header))
     return {name: data[:, k] for k, name in enumerate(header)}
 
 
+def _capped_lines(f: io.TextIOWrapper, limit: int) -> Iterator[str]:
+    """The lines of ``f`` until ``limit`` characters have been read (a file that grows while it is read,
+    being written on and on, stops there with an error instead of running forever)."""
+    seen = 0
+    for line in f:
+        seen += len(line)
+        if seen > limit:
+            raise InputRefused(f"more than a trajectory may have ({size_text(MAX_BYTES)})")
+        yield line
+
+
+def _check_npz_members(archive: zipfile.ZipFile) -> None:
+    """Refuse an archive before anything is inflated: more than MAX_BYTES of members, or an ``.npy``
+    member whose header claims more rows than its bytes hold (np.load would allocate them first)."""
+    members = archive.infolist()
+    total = sum(m.file_size for m in members)
+    if total > MAX_BYTES:
+        raise InputRefused(
+            f"its arrays hold {total} bytes, more than a trajectory may have ({size_text(MAX_BYTES)})"
+        )
+    for m in members:
+        if not m.filename.endswith(".npy"):
+            continue
+        with archive.open(m) as member:
+            version = np.lib.format.read_magic(member)
+            read_header = {
+                (1, 0): np.lib.format.read_array_header_1_0,
+                (2, 0): np.lib.format.read_array_header_2_0,
+            }
+            if version not in read_header:
+                raise InputRefused(f"array {m.filename!r} has an unknown .npy version {version}")
+            shape, _, dtype = read_header[version](member)
+            claimed = math.prod(shape) * dtype.itemsize
+            if claimed > m.file_size:
+                raise InputRefused(f"array {m.filename!r} claims shape {shape} but holds {m.file_size} bytes")
+
+
 def _columns_from_npz(path: Path) -> dict[str, np.ndarray]:
-    if path.is_file() and not zipfile.is_zipfile(path):
-        raise TrajectoryError(f"{path}: not an .npz archive")
-    with np.load(path, allow_pickle=False) as npz:
-        arrays = {name: np.asarray(npz[name]) for name in npz.files}
+    with open_regular(path, MAX_BYTES, "a trajectory") as f:
+        if not zipfile.is_zipfile(f):
+            raise TrajectoryError(f"{path}: not an .npz archive")
+        f.seek(0)
+        with zipfile.ZipFile(f) as archive:
+            _check_npz_members(archive)
+        f.seek(0)
+        with np.load(f, allow_pickle=False) as npz:
+            arrays = {name: np.asarray(npz[name]) for name in npz.files}
     for name, (width, column) in STACKED.items():  # stacked (rows, k) arrays → the CSV's columns
         if name in arrays and arrays[name].ndim == 2 and arrays[name].shape[1] == width:
             stacked = arrays.pop(name)
@@ -82,7 +142,8 @@ def _columns_from_npz(path: Path) -> dict[str, np.ndarray]:
 
 
 def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
-    """Load a trajectory file (``.csv`` or ``.npz``); with ``n_balls``, check it has that many balls."""
+    """Load a trajectory file (``.csv`` or ``.npz``); with ``n_balls``, check it starts with that many
+    balls (the scene's). Balls may be added later in it (they get the next ids), never removed."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in (".csv", ".npz"):
@@ -91,8 +152,12 @@ def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
         columns = _columns_from_csv(path) if suffix == ".csv" else _columns_from_npz(path)
     except TrajectoryError:
         raise
-    except FileNotFoundError:
-        raise TrajectoryError(f"{path}: no such file") from None
+    except InputRefused as e:
+        raise TrajectoryError(f"{path}: {e}") from None
+    except BlockingIOError:
+        raise TrajectoryError(f"{path}: reading it would wait for data: not an ordinary file") from None
+    except MemoryError:
+        raise TrajectoryError(f"{path}: too large to read into memory") from None
     except (OSError, ValueError, zipfile.BadZipFile, UnicodeDecodeError, EOFError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise TrajectoryError(f"{path}: cannot read the trajectory ({reason})") from None
@@ -100,36 +165,93 @@ def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
     if missing:
         raise TrajectoryError(f"{path}: missing trajectory columns: {', '.join(missing)}")
     try:
-        table = np.column_stack([np.asarray(columns[name], dtype=float).reshape(-1)
-                                 for name in TRAJECTORY_COLUMNS])  # fmt: skip
-    except ValueError:
-        raise TrajectoryError(f"{path}: the trajectory columns have different lengths") from None
-    if len(table) == 0:
+        table = [np.asarray(columns.pop(name), dtype=float).reshape(-1) for name in TRAJECTORY_COLUMNS]
+    except (TypeError, ValueError):
+        raise TrajectoryError(f"{path}: the trajectory columns must hold numbers") from None
+    rows = len(table[0])
+    if any(len(c) != rows for c in table):
+        raise TrajectoryError(f"{path}: the trajectory columns have different lengths")
+    if rows == 0:
         raise TrajectoryError(f"{path}: the trajectory has no rows")
-    if not np.all(np.isfinite(table)):
+    if not all(np.isfinite(c).all() for c in table):
         raise TrajectoryError(f"{path}: the trajectory holds values that are not finite numbers")
-    ids = table[:, 1]
-    count = int(ids.max()) + 1
-    if count * (len(table) // count) != len(table) or not np.array_equal(
-        ids.reshape(-1, count), np.broadcast_to(np.arange(count), (len(table) // count, count))
-    ):
-        raise TrajectoryError(f"{path}: rows must list ids 0..N-1 for every recorded time")
-    if n_balls is not None and count != n_balls:
-        raise TrajectoryError(f"{path}: the trajectory has {count} balls but the scene has {n_balls}")
-    frames = table.reshape(-1, count, len(TRAJECTORY_COLUMNS))
-    times = frames[:, 0, 0].copy()
-    if np.any(np.diff(times) < 0) or np.any(frames[:, :, 0] != times[:, None]):
+    times, ids = table[0], table[1]
+    frame, counts = _records(path, ids)
+    if n_balls is not None and counts[0] != n_balls:
+        raise TrajectoryError(f"{path}: the trajectory has {counts[0]} balls but the scene has {n_balls}")
+    n = int(counts.max())
+    if len(counts) * n * (len(TRAJECTORY_COLUMNS) - 2) * 8 > MAX_BYTES:
+        raise TrajectoryError(
+            f"{path}: {len(counts)} records of up to {n} balls are more than a replay holds "
+            f"({size_text(MAX_BYTES)})"
+        )
+    starts = np.flatnonzero(ids == 0)
+    frame_times = times[starts]
+    if np.any(np.diff(frame_times) < 0) or np.any(times != frame_times[frame]):
         raise TrajectoryError(f"{path}: the times must be the same for every ball of a record, never falling")
-    return Trajectory(path, times, frames[:, :, 2:5].copy(), frames[:, :, 5:8].copy(),
-                      frames[:, :, 8:11].copy(), frames[:, :, 11:15].copy())  # fmt: skip
+    slot = ids.astype(np.intp)
+
+    def frames_of(first: int, width: int) -> np.ndarray:
+        out = (
+            np.full((len(counts), n, width), np.nan)
+            if counts.min() < n
+            else np.empty((len(counts), n, width))
+        )
+        for k in range(width):
+            out[frame, slot, k] = table[first + k]
+        return out
+
+    return Trajectory(path, frame_times.copy(), frames_of(2, 3), frames_of(5, 3), frames_of(8, 3),
+                      frames_of(11, 4), counts if counts.min() < n else None)  # fmt: skip
+
+
+def _records(path: Path, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's record (frame) index and each record's ball count, from the id column: every record
+    lists ids 0..n-1 in order, and n never falls (balls are only added)."""
+    whole = (ids >= 0) & (ids < 2**31) & (ids == np.floor(ids))
+    if not whole.all():
+        bad = ids[~whole][0]
+        raise TrajectoryError(f"{path}: ball ids must be whole numbers from 0, got {bad:g}")
+    first = ids == 0
+    if not first[0]:
+        raise TrajectoryError(
+            f"{path}: rows must list ids 0..N-1 for every recorded time (the first is {ids[0]:g})"
+        )
+    starts = np.flatnonzero(first)
+    frame = np.cumsum(first) - 1
+    if not np.array_equal(ids, np.arange(len(ids)) - starts[frame]):
+        raise TrajectoryError(f"{path}: rows must list ids 0..N-1 for every recorded time")
+    counts = np.diff(np.append(starts, len(ids)))
+    fell = np.flatnonzero(np.diff(counts) < 0)
+    if len(fell):
+        k = int(fell[0])
+        raise TrajectoryError(
+            f"{path}: record {k + 2} has {counts[k + 1]} balls, fewer than the {counts[k]} before: "
+            "balls can be added during a run, not removed"
+        )
+    return frame, counts
+
+
+SHOT_RADIUS, SHOT_MASS = 0.25, 1.0  # what B shoots when the scene has no balls (interaction.py)
 
 
 class Replay:
-    """A trajectory as the viewer's timeline: steps are frames; ``seek(k)`` shows frame k."""
+    """A trajectory as the viewer's timeline: steps are frames; ``seek(k)`` shows frame k.
+
+    A recording that gained balls (B) shows each from the frame it appears in: the world holds the
+    scene's balls plus those of the frame shown. An added ball is as big and heavy as the scene's
+    median ball, as B makes it (a trajectory has no radius column)."""
 
     def __init__(self, world: Any, trajectory: Trajectory) -> None:
         self.world = world
         self.trajectory = trajectory
+        self._scene = world.snapshot() if trajectory.counts is not None else None
+        spheres = world.spheres
+        self._added = (
+            (float(np.median(spheres.radii)), float(np.median(spheres.masses)))
+            if len(spheres)
+            else (SHOT_RADIUS, SHOT_MASS)
+        )
         self.first = 0
         self.latest = trajectory.frames - 1
         self.current = -1
@@ -149,15 +271,28 @@ class Replay:
         """Write frame ``step`` (clamped) into the world."""
         step = int(min(max(step, self.first), self.latest))
         t = self.trajectory
+        n = t.balls_at(step)
+        self._hold(n, step)
         spheres = self.world.spheres
-        spheres.positions[:] = t.position[step]
-        spheres.velocities[:] = t.velocity[step]
-        spheres.angular_velocities[:] = t.angular_velocity[step]
-        spheres.orientations[:] = t.orientation[step]
+        spheres.positions[:] = t.position[step, :n]
+        spheres.velocities[:] = t.velocity[step, :n]
+        spheres.angular_velocities[:] = t.angular_velocity[step, :n]
+        spheres.orientations[:] = t.orientation[step, :n]
         self.world.time = float(t.times[step])
         self.current = step
         self.clock = float(t.times[step])
         return step
+
+    def _hold(self, n: int, step: int) -> None:
+        """Make the world hold ``n`` balls: the scene's, then those added in the recording."""
+        world = self.world
+        if self._scene is None or len(world.spheres) == n:
+            return
+        world.restore(self._scene)
+        first = len(world.spheres)
+        if n > first:
+            radius, mass = self._added
+            world.add_spheres(self.trajectory.position[step, first:n], radius=radius, mass=mass)
 
     def step_by(self, steps: int) -> int:
         return self.seek(self.current + steps)

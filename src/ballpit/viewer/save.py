@@ -19,6 +19,8 @@ import numpy as np
 import tomlkit
 from tomlkit.items import AoT, Table
 
+from ..scene.overlap import deepest_overlap
+from ..scene.schema import OVERLAP_TOLERANCE
 from .camera import Camera
 from .simulation import Simulation
 
@@ -185,7 +187,17 @@ def scene_document(
         _plane_motion(planes[i], np.asarray(velocity, dtype=float), np.asarray(spin, dtype=float))
 
     _write_balls(doc, sim)
+    _allow_resting_overlap(doc, world)
     return doc
+
+
+def _allow_resting_overlap(doc: tomlkit.TOMLDocument, world: object) -> None:
+    """Let the saved state load: balls at rest press a little into each other and into the floor,
+    more than a scene's start allows by default, so [world] allows twice the deepest overlap now."""
+    spheres = world.spheres  # type: ignore[attr-defined]
+    deepest = deepest_overlap(spheres.positions, spheres.radii, world.planes)  # type: ignore[attr-defined]
+    if deepest > OVERLAP_TOLERANCE:
+        _set(doc["world"], "overlap_tolerance", float(f"{2 * deepest:.2g}"))
 
 
 def _write_balls(doc: tomlkit.TOMLDocument, sim: Simulation) -> None:

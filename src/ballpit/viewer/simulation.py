@@ -23,6 +23,7 @@ import numpy as np
 
 from ..physics.profile import RunProfile
 from ..scene import Appearance, Scene, read_scene, scene_of
+from ..scene.colours import palette_colors
 from .replay import Trajectory
 from .timeline import Timeline
 
@@ -155,11 +156,15 @@ class Simulation:
         """History, replay, ghosts and energy trace start afresh (ghosts stay on if they were)."""
         ghosts = getattr(self, "timeline", None) is not None and self.timeline.ghosts is not None
         trajectory = self.trajectory
-        if trajectory is not None and trajectory.balls != self.ball_count:
-            self.error = (
-                f"{trajectory.path}: the trajectory has {trajectory.balls} balls, the scene {self.ball_count}"
-            )
+        if trajectory is not None and trajectory.balls_at(0) != self.ball_count:
+            balls = trajectory.balls_at(0)
+            self.error = f"{trajectory.path}: the trajectory has {balls} balls, the scene {self.ball_count}"
             trajectory = None
+        if trajectory is not None and trajectory.balls > self.ball_count:  # balls added in the recording
+            look, first = self.appearance, self.ball_count
+            look.sphere_colors = np.vstack(
+                [look.sphere_colors, palette_colors(trajectory.balls - first, first)]
+            )
         self.timeline = Timeline(
             self.world, self.timestep, trajectory, on_seek=self.after_seek, on_replay_end=self.end_of_replay
         )

@@ -79,8 +79,11 @@ class Timeline:
         """One fixed step: the physics (recorded, ghosts alongside) or the next replay frame."""
         world = self.world
         if self.replay is not None:
+            balls = len(world.spheres)
             if not self.replay.advance(dt):
                 self._on_replay_end()
+            if len(world.spheres) != balls:  # the recording gained a ball here
+                self._on_seek(None)
             return _no_contacts()
         contacts = world.step(dt)
         if self.history is not None:

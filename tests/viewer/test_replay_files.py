@@ -1,0 +1,226 @@
+"""``view --replay`` against recordings that gained balls and against hostile files (issue #25,
+section 3): a record made after B added a ball replays; a FIFO, a device, a deflate bomb, a header
+claiming 10¹² rows or ids that are not 0..N-1 are one-line errors with exit status 2, before any
+window and before anything large is read."""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ballpit import cli
+from ballpit.scene import read_scene
+from ballpit.viewer import replay as replay_module
+from ballpit.viewer.recording import Recorder
+from ballpit.viewer.replay import Replay, read_trajectory
+from ballpit.viewer.simulation import Simulation
+from ballpit.writers import TRAJECTORY_COLUMNS
+
+ROOT = Path(__file__).resolve().parents[2]
+SLOPES = ROOT / "scenes" / "slopes.toml"
+
+
+def _record_with_a_shot(path: Path) -> tuple[Simulation, int]:
+    """slopes.toml recorded in the viewer's way: 20 steps, a ball shot in (what B does), 20 more."""
+    sim = Simulation(read_scene(SLOPES), SLOPES, step_budget=math.inf)
+    recorder = Recorder(path, sim)
+    sim.start()
+    dt = sim.timestep
+    sim.advance(20 * dt + 1e-9)
+    shot = sim.add_ball((1.0, 0.0, 0.0), position=(0.0, 6.0, 2.0), radius=0.2, velocity=(0.0, 0.0, -3.0))
+    sim.advance(20 * dt + 1e-9)
+    recorder.finish()
+    return sim, shot
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".csv"])
+def test_a_record_made_after_a_ball_was_shot_in_replays(tmp_path, suffix):
+    path = tmp_path / f"run{suffix}"
+    live, shot = _record_with_a_shot(path)
+    t = read_trajectory(path, n_balls=5)
+    assert t.frames == 41 and t.balls == 6
+    assert t.balls_at(0) == 5 and t.balls_at(20) == 5 and t.balls_at(21) == 6 and t.balls_at(40) == 6
+    assert np.isnan(t.position[20, 5]).all()  # not there yet
+    rtol = 0 if suffix == ".npz" else 1e-8
+    np.testing.assert_allclose(t.position[40], live.world.spheres.positions, rtol=rtol, atol=1e-12)
+
+    sim = Simulation(read_scene(SLOPES), SLOPES, trajectory=t)
+    assert sim.error is None and sim.ball_count == 5
+    assert len(sim.appearance.sphere_colors) == 6  # a colour for the added ball, as B gives it
+    sim.start()
+    sim.advance(30 * sim.timestep)  # plays on past the frame the ball appears in
+    assert sim.ball_count == 6 and len(sim.prev_positions) == 6
+    current = sim.timeline.replay.current
+    np.testing.assert_allclose(sim.world.spheres.positions, t.position[current], rtol=rtol, atol=1e-12)
+    assert sim.world.spheres[shot].radius == pytest.approx(np.median(read_scene(SLOPES).world.spheres.radii))
+    sim.toggle_pause()
+    sim.scrub(0.0)  # back before the shot: the scene's five balls again
+    assert sim.ball_count == 5 and len(sim.trails.ordered()[0]) == 5
+    np.testing.assert_array_equal(sim.world.spheres.positions, t.position[0, :5])
+
+
+def _write_csv(path: Path, rows: list[list[float]]) -> Path:
+    lines = [",".join(TRAJECTORY_COLUMNS)] + [",".join(map(repr, r)) for r in rows]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _row(time: float, ball: float) -> list[float]:
+    return [time, ball, 0.0, 1.0, 0.0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1]
+
+
+def _replay_status(path: Path, capsys) -> str:
+    status = cli.main(["view", "slopes", "--replay", str(path)])
+    err = capsys.readouterr().err
+    assert status == cli.EXIT_BAD_INPUT, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    return err
+
+
+@pytest.mark.parametrize(
+    ("ids", "fragment"),
+    [
+        ([-1, -1], "ball ids must be whole numbers from 0, got -1"),
+        ([0, -2], "ball ids must be whole numbers from 0, got -2"),
+        ([0, 0.5], "got 0.5"),
+        ([1, 2], "ids 0..N-1"),
+        ([0, 1, 0], "fewer than the 2 before"),
+    ],
+)
+def test_ids_that_are_not_zero_to_n_minus_1_are_one_line_errors(tmp_path, capsys, ids, fragment):
+    times = [0.0] * 2 + [0.1] * (len(ids) - 2) if len(ids) > 2 else [0.0] * len(ids)
+    path = _write_csv(tmp_path / "ids.csv", [_row(t, i) for t, i in zip(times, ids, strict=True)])
+    assert fragment in _replay_status(path, capsys)
+
+
+def _view_replay(path: Path) -> subprocess.CompletedProcess:
+    """In a child with a time limit: a read that blocks fails the test instead of hanging the suite."""
+    return subprocess.run(
+        [sys.executable, "-m", "ballpit", "view", "slopes", "--replay", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=ROOT,
+    )
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz"])
+def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path, suffix):
+    fifo = tmp_path / f"run{suffix}"
+    os.mkfifo(fifo)
+    r = _view_replay(fifo)
+    assert r.returncode == 2, r.stderr
+    assert "not a regular file" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
+def test_an_endless_file_is_refused(tmp_path, device):
+    endless = tmp_path / "endless.csv"
+    endless.symlink_to(device)
+    r = _view_replay(endless)
+    assert r.returncode == 2, r.stderr
+    assert "not a regular file" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def _npy_member(archive: zipfile.ZipFile, name: str, shape: tuple, payload: bytes, **kwargs) -> None:
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    archive.writestr(name, header.getvalue() + payload, **kwargs)
+
+
+def test_a_header_claiming_a_trillion_rows_is_refused_before_allocating(tmp_path, capsys):
+    path = tmp_path / "huge.npz"
+    with zipfile.ZipFile(path, "w") as archive:
+        for column in TRAJECTORY_COLUMNS:
+            _npy_member(archive, f"{column}.npy", (10**12,), np.zeros(4).tobytes())
+    err = _replay_status(path, capsys)
+    assert "claims shape (1000000000000,)" in err
+
+
+def test_a_deflate_bomb_is_refused_before_it_is_inflated(tmp_path, capsys, monkeypatch):
+    """Arrays whose inflated size is beyond the limit (here lowered to 1 MiB, so the bomb stays small to
+    build; the real limit is 2 GiB) are refused from the archive's directory, unread."""
+    monkeypatch.setattr(replay_module, "MAX_BYTES", 1 << 20)
+    path = tmp_path / "bomb.npz"
+    rows = (2 << 20) // 8
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            _npy_member(archive, f"{column}.npy", (rows,), bytes(rows * 8))
+    assert path.stat().st_size < 200_000  # a small file that inflates to 30 MiB
+    err = _replay_status(path, capsys)
+    assert "more than a trajectory may have (1 MiB)" in err
+    assert replay_module.MAX_BYTES == 1 << 20 and 2 << 30 == 2147483648
+
+
+def test_a_bomb_that_understates_its_size_is_refused_unread(tmp_path, capsys):
+    """A bomb whose directory says its members are small: their headers claim more than that, so they
+    are refused before np.load allocates (and zipfile never inflates past the size it was told)."""
+    path = tmp_path / "liar.npz"
+    rows = 1 << 20
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            _npy_member(archive, f"{column}.npy", (rows,), bytes(rows * 8))
+    blob = bytearray(path.read_bytes())
+    # Rewrite each member's uncompressed size (local header and central directory) to 200 bytes.
+    with zipfile.ZipFile(path) as archive:
+        infos = archive.infolist()
+    for info in infos:
+        real = info.file_size.to_bytes(4, "little")
+        blob = blob.replace(real, (200).to_bytes(4, "little"))
+    path.write_bytes(bytes(blob))
+    err = _replay_status(path, capsys)
+    # zipfile stops at the 200 bytes it was told of, and finds their checksum wrong
+    assert "claims shape (1048576,) but holds 200 bytes" in err or "Bad CRC-32" in err
+
+
+def test_a_kernel_file_whose_reads_block_is_refused_by_every_command():
+    """/proc/kmsg is a 'regular' file to stat whose reads wait for kernel messages; read by root it
+    hung check, simulate, compare and view. Without root it is 'permission denied'; either way, no wait."""
+    kmsg = Path("/proc/kmsg")
+    if not kmsg.exists():
+        pytest.skip("no /proc/kmsg on this system")
+    for command in (["check"], ["simulate", "-q"], ["compare", "-q"], ["view"]):
+        r = subprocess.run(
+            [sys.executable, "-m", "ballpit", command[0], str(kmsg), *command[1:]],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            cwd=ROOT,
+        )
+        assert r.returncode == 2, (command, r.stderr)
+        assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+
+
+def test_replay_seek_outside_the_added_balls_keeps_the_scene_balls(tmp_path):
+    path = tmp_path / "run.csv"
+    _record_with_a_shot(path)
+    world = read_scene(SLOPES).world
+    t = read_trajectory(path)
+    r = Replay(world, t)
+    for frame in (40, 3, 25, 0):
+        r.seek(frame)
+        assert len(world.spheres) == t.balls_at(frame)
+        np.testing.assert_array_equal(world.spheres.positions, t.position[frame, : t.balls_at(frame)])
+
+
+def test_csv_rows_that_never_end_stop_at_the_size_limit(monkeypatch):
+    """A CSV that keeps growing while it is read (a run still writing it) is read no further than the
+    limit: here an endless stream of rows against a limit of 1 MiB."""
+    import itertools
+
+    monkeypatch.setattr(replay_module, "MAX_BYTES", 1 << 20)
+    row = ",".join(["0"] * len(TRAJECTORY_COLUMNS)) + "\n"
+    lines = replay_module._capped_lines(itertools.repeat(row), 1 << 20)
+    read = 0
+    with pytest.raises(replay_module.InputRefused, match=r"more than a trajectory may have \(1 MiB\)"):
+        for line in lines:
+            read += len(line)
+    assert read <= 1 << 20
