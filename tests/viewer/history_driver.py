@@ -213,7 +213,56 @@ def replay(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay)}
+def replay_refuses_reaching_in(workdir: Path) -> dict:
+    """B (a real X key press) and a real pointer drag on a ball, in a replay: each is refused with a
+    message, and the replay plays on frame by frame as recorded."""
+    from ballpit.viewer.replay import read_trajectory
+
+    scene = Path(sys.argv[3])
+    trajectory = read_trajectory(workdir / sys.argv[4])
+    viewer = wd.open_viewer(size=(640, 360), scene_path=scene, trajectory=trajectory)
+    sim = viewer.sim
+    rp = sim.timeline.replay
+
+    def frame_matches() -> bool:
+        return bool(np.array_equal(np.asarray(sim.world.spheres.positions), trajectory.position[rp.current]))
+
+    def state() -> dict:
+        return {"frame": rp.current, "matches": frame_matches(), "balls": sim.ball_count,
+                "phase": sim.phase.name, "error": sim.error}  # fmt: skip
+
+    wd.pump(viewer, 10)
+    wd.point_at(viewer)
+    out: dict = {"before": state()}
+    wd.xdotool("key", "b")
+    wd.settle(viewer)
+    out["b_message"] = wd.shown_message(viewer)
+    wd.pump(viewer, 30)  # 0.5 s more of the replay
+    out["after_b"] = state()
+
+    wd.press(viewer, "SPACE")  # paused, so the ball stays under the pointer
+    at = state()
+    pixels, _ = viewer.camera.project(np.asarray(sim.world.spheres.positions)[:1], 640, 360)
+    x, y = (int(v) for v in pixels[0])  # ball 0's centre, from the top-left corner
+    wid = str(viewer.window._window)
+    wd.xdotool("mousemove", "--window", wid, str(x), str(y))
+    wd.settle(viewer, 3)
+    wd.xdotool("mousedown", "1")
+    wd.settle(viewer, 3)
+    wd.xdotool("mousemove", "--window", wid, str(x + 60), str(y - 40))
+    wd.settle(viewer, 3)
+    out["drag_message"] = wd.shown_message(viewer)
+    out["held"] = viewer.interaction.held_ball
+    wd.xdotool("mouseup", "1")
+    wd.settle(viewer, 3)
+    out["paused_at"], out["after_drag"] = at, state()
+    wd.press(viewer, "SPACE")
+    wd.pump(viewer, 30)
+    out["resumed"] = state()
+    return out
+
+
+SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in)}
 
 
 def main() -> None:

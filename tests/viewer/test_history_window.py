@@ -89,3 +89,21 @@ def test_a_simulate_trajectory_replays_with_pause_step_scrub_and_time_scale(xvfb
     assert scale == 2.0 and elapsed == pytest.approx(1.0, abs=0.02) and matches  # 0.5 s of frames at ×2
     assert r["end"] == [480, 480, "PAUSED"]
     assert "replay      run.npz" in r["hud"]
+
+
+def test_b_and_dragging_a_ball_in_a_replay_are_refused_with_a_message_and_the_replay_plays_on(
+    xvfb, tmp_path, slopes_run
+):
+    r = run_scenario(
+        xvfb, "replay_refuses_reaching_in", tmp_path, str(REPO / "scenes" / "slopes.toml"), slopes_run.name
+    )
+    assert r["before"]["phase"] == "RUNNING" and r["before"]["balls"] == 5
+    assert "not available in a replay" in r["b_message"]
+    after = r["after_b"]
+    assert after["balls"] == 5 and after["error"] is None and after["phase"] == "RUNNING"
+    assert after["frame"] >= r["before"]["frame"] + 100 and after["matches"]  # 0.5 s more, as recorded
+    assert "not available in a replay" in r["drag_message"] and r["held"] is None
+    assert r["after_drag"] == r["paused_at"] and r["after_drag"]["matches"]  # nothing moved
+    resumed = r["resumed"]
+    assert resumed["frame"] >= r["paused_at"]["frame"] + 100 and resumed["matches"]
+    assert resumed["error"] is None and resumed["balls"] == 5

@@ -41,6 +41,8 @@ TILT_KEYS: dict[str, tuple[str, float]] = {
     "RIGHT": ("forward", 1.0),
 }
 LIFT_KEYS: dict[str, float] = {"PAGEUP": 1.0, "PAGEDOWN": -1.0}
+# A replay writes recorded frames into the world: a ball added or moved there has no frames to follow.
+NOT_IN_REPLAY = "{} is not available in a replay: it plays a recorded run"
 PLANE_KEYS = frozenset(TILT_KEYS) | frozenset(LIFT_KEYS)
 
 
@@ -74,6 +76,8 @@ class Interaction:
         if hit.kind == "plane":
             self.select(hit.index)
             return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+        if self.in_replay:
+            return NOT_IN_REPLAY.format("dragging a ball")
         ball = self.sim.world.spheres[hit.index]
         centre = np.array(ball.position, dtype=float)
         grabbed = ray_plane_point(ray, centre, np.asarray(facing, dtype=float))
@@ -192,9 +196,13 @@ class Interaction:
         self.shot_speed = bigger[0] if bigger else SHOT_SPEEDS[0]
         return self.shot_speed
 
-    def shoot(self, camera: Camera) -> int:
-        """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index.
+    def shoot(self, camera: Camera) -> int | None:
+        """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index
+        (None in a replay, where the HUD says B is not available).
         It is as big and heavy as the scene's typical (median) ball."""
+        if self.in_replay:
+            self.sim.message = NOT_IN_REPLAY.format("B (shoot a ball)")
+            return None
         spheres = self.sim.world.spheres
         radius = float(np.median(spheres.radii)) if len(spheres) else SHOT_RADIUS
         mass = float(np.median(spheres.masses)) if len(spheres) else SHOT_MASS
@@ -206,6 +214,11 @@ class Interaction:
         )
 
     # ------------------------------------------------------------------ state
+    @property
+    def in_replay(self) -> bool:
+        """Whether the window plays a recorded run (``view --replay``) instead of live physics."""
+        return self.sim.timeline.replay is not None
+
     def clear(self) -> None:
         """Reset hook: the world was replaced, so let go of everything (nothing to give back)."""
         self.held_ball = None
