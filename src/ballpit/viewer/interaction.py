@@ -46,6 +46,21 @@ NOT_IN_REPLAY = "{} is not available in a replay: it plays a recorded run"
 PLANE_KEYS = frozenset(TILT_KEYS) | frozenset(LIFT_KEYS)
 
 
+def typical_material(spheres: object) -> dict[str, float]:
+    """The most common (restitution, friction, rolling friction) among ``spheres`` (the first of the
+    most common on a tie), as ``add_sphere`` arguments; {} when there are no balls (the defaults).
+
+    A shot ball made of it rolls to a stop where the scene's own balls do, rather than rolling on for
+    ever without the rolling friction they have."""
+    names = ("restitution", "friction", "rolling_friction")
+    if not len(spheres):  # type: ignore[arg-type]
+        return {}
+    rows = np.array([[getattr(ball, name) for name in names] for ball in spheres])  # type: ignore[attr-defined]
+    kinds, first, counts = np.unique(rows, axis=0, return_index=True, return_counts=True)
+    best = np.lexsort((first, -counts))[0]  # the most common, then the earliest
+    return dict(zip(names, (float(v) for v in kinds[best]), strict=True))
+
+
 class Interaction:
     """What the user's hands are doing to one Simulation: a held ball, a selected plane, the shot speed."""
 
@@ -199,7 +214,7 @@ class Interaction:
     def shoot(self, camera: Camera) -> int | None:
         """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index
         (None in a replay, where the HUD says B is not available).
-        It is as big and heavy as the scene's typical (median) ball."""
+        It is as big and heavy as the scene's typical (median) ball, and made of its typical material."""
         if self.in_replay:
             self.sim.message = NOT_IN_REPLAY.format("B (shoot a ball)")
             return None
@@ -210,8 +225,9 @@ class Interaction:
         start = np.asarray(camera.position, dtype=float) + forward * (2.0 * radius + camera.near)
         color = palette_colors(1, first=len(spheres))[0]
         return self.sim.add_ball(
-            color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed
-        )
+            color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed,
+            **typical_material(spheres),
+        )  # fmt: skip
 
     # ------------------------------------------------------------------ state
     @property
