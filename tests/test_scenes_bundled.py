@@ -7,6 +7,7 @@ the way a user would check it.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -87,6 +88,33 @@ def test_piles_pour_into_a_box(name, at_least):
     pos = world.spheres.positions
     half = floor.size[0] / 2
     assert (np.abs(pos[:, [0, 2]]) < half).all() and (pos[:, 1] > 0).all()
+
+
+MULTIPLES = {"twice": 2, "three times": 3, "four times": 4, "five times": 5, "six times": 6,
+             "seven times": 7, "eight times": 8, "nine times": 9, "ten times": 10}  # fmt: skip
+
+
+def test_ballpit_scenes_states_true_ball_counts():
+    """Every count ``ballpit scenes`` gives ("1,200 balls", "the 1,200-ball pile.toml", "eight times
+    over" another scene) is what the scenes hold."""
+    r = ballpit("scenes")
+    assert r.returncode == 0, r.stderr
+    counts = {p.stem: len(load_scene(p).spheres) for p in bundled_scenes()}
+    checked = 0
+    for line in r.stdout.splitlines():
+        name, text = line.split(None, 1)
+        number = r"(\d{1,3}(?:,\d{3})+|\d+)"
+        for n in re.findall(number + r"(?=(?: [a-z]+,?){0,3} balls\b)", text):
+            assert int(n.replace(",", "")) == counts[name], line
+            checked += 1
+        for n, other in re.findall(number + r"-ball (\w+)\.toml", text):
+            assert int(n.replace(",", "")) == counts[other], line
+            checked += 1
+        for other in re.findall(r"(\w+)\.toml", text):
+            for words, k in MULTIPLES.items():
+                if words in text:
+                    assert k * counts[other] == counts[name], line
+    assert checked >= 3  # gas, pile and pile10k at least
 
 
 def test_incline_balls_accelerate_as_the_textbook_says(tmp_path):
