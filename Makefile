@@ -1,18 +1,22 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
+# demo installs only what ballpit itself needs; test adds the test tools (pytest, ruff, scipy, ...).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 
 .PHONY: demo test lint format bench clean
 
-$(VENV)/.installed: pyproject.toml
+$(VENV)/.ballpit: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed: $(VENV)/.ballpit
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $@
 
 # With no display the viewer prints how to render offscreen instead; that is not a failure here.
-demo: $(VENV)/.installed
+demo: $(VENV)/.ballpit
 	@$(VENV)/bin/ballpit || { status=$$?; [ -z "$$DISPLAY" ] && [ $$status -eq 1 ] || exit $$status; }
 
 test: $(VENV)/.installed
@@ -28,7 +32,7 @@ format: $(VENV)/.installed
 	$(VENV)/bin/ruff format .
 	$(VENV)/bin/ruff check --fix .
 
-bench: $(VENV)/.installed
+bench: $(VENV)/.ballpit
 	$(VENV)/bin/ballpit bench
 
 clean:

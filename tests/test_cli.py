@@ -554,3 +554,35 @@ def test_render_into_a_path_through_a_file_is_one_line(tmp_path):
     r = ballpit("render", "scenes/slopes.toml", "--out", tmp_path / ("a" * 300 + ".gif"))
     assert_user_error(r, "--out", "304 bytes")
     assert [p.name for p in tmp_path.iterdir()] == ["notadir"]
+
+
+# ballpit as installed without the plot extra: matplotlib cannot be imported.
+WITHOUT_MATPLOTLIB = (
+    "import sys; sys.modules['matplotlib'] = None; from ballpit.cli import main; sys.exit(main(sys.argv[1:]))"
+)
+
+
+def without_matplotlib(*args: str | Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-c", WITHOUT_MATPLOTLIB, *map(str, args)],
+        capture_output=True, text=True, cwd=ROOT, timeout=timeout,
+    )  # fmt: skip
+
+
+def test_without_matplotlib_the_viewers_commands_run_and_plot_options_say_what_to_install(tmp_path):
+    # what the viewer and the headless runner need works without it
+    r = without_matplotlib("simulate", "scenes/slopes.toml", "--duration", "0.1", "--out", tmp_path / "t.csv")
+    assert r.returncode == 0, r.stderr
+    r = without_matplotlib("render", "scenes/slopes.toml", "--out", tmp_path / "f.png", "--duration", "0.1",
+                           "--size", "64x48")  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "f.png").is_file()
+    # --plot is refused up front, in one line naming the extra, before any run
+    png = tmp_path / "e.png"
+    for args in (["simulate", "scenes/slopes.toml", "--duration", "30"], ["compare", "scenes/slopes.toml"]):
+        r = without_matplotlib(*args, "--plot", png)
+        assert_user_error(r, "--plot needs matplotlib", "pip install 'ballpit[plot]'")
+    r = without_matplotlib("bench", "--workload", "free", "--sizes", "8", "--steps", "2", "--plot", png)
+    assert_user_error(r, "--plot needs matplotlib", "ballpit[plot]")
+    assert "steps/s" not in r.stdout  # nothing was measured first
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "t.csv"]

@@ -294,6 +294,11 @@ def main(argv: list[str] | None = None) -> int:
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )
     args = parser.parse_args(argv)
+    if args.plot and not args.one:
+        from .plots import MISSING_MATPLOTLIB, have_matplotlib
+
+        if not have_matplotlib():  # say so now, not after the measurements
+            parser.error(f"--plot {MISSING_MATPLOTLIB}")
 
     if args.one:
         keep_freed_memory()  # as the app runs the engine (allocator.py)
