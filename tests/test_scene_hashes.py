@@ -19,6 +19,8 @@ pile and pile10k, when Jacobi solves began to update friction in every fourth sw
 impulses alone in the others (#13: speed); the six other scenes never solve 64 contacts at once.
 pile and pile10k, when every solve of a crowded step became Jacobi, however few its contacts (#13:
 speed); no other scene takes a crowded step.
+integrators, added (#23: a scene where Euler, RK2 and RK4 visibly part ways); its hash was the same
+with OpenBLAS's Sandybridge kernels and NumPy's AVX2/AVX512/FMA3 paths switched off.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ HASHES = {
     "gas": "79e162b84f53a910af613dc94d8d339dee9ff8d29570023a3c7c26e15d627db8",
     "pile": "2ed3ffe792a2939ca1568c0e2102c482cf23422cdcfb0fc49b05c31b04ff7091",
     "pile10k": "6b636cf3573033334a520a29e54401fff17fb6a403c54072ef6ee2f53a14fc38",
+    "integrators": "32f989f23c6d7c8d2f45df00b23ad46abd660e8028d24f1560c2201684005e1f",
     "seesaw": "62599274fca23f940b3383039e4887c86d7f9ad2a3f515d5c631e5fad3379d11",
 }
 

@@ -21,7 +21,7 @@ from ballpit.viewer.camera import Camera
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw"}
+REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw", "integrators"}
 # Enough simulated time to exercise each scene while keeping the suite fast (big piles: a few steps).
 SHORT_RUN = {"pile": 3, "pile10k": 2, "gas": 3, "billiards": 20}  # steps
 DEFAULT_STEPS = 24
@@ -133,6 +133,29 @@ def test_cradle_passes_momentum_down_the_line(tmp_path):
     assert np.allclose(last[:5, 5], 0, atol=0.02), "the striker and the middle balls stop"
     assert last[5, 5] == pytest.approx(2.0, rel=0.01), "the far ball leaves at the striker's speed"
     assert (kinds == "sphere-sphere").sum() >= 5
+
+
+def test_integrators_agree_at_first_then_part_ways(tmp_path):
+    """The integrators demo, judged from ``ballpit simulate --integrator`` output: drag is the only force
+    that changes within a step, so the three runs agree to millimetres for the first second; the
+    balls' meetings then multiply the difference until Euler's and RK2's balls are far from RK4's."""
+    world = load_scene(SCENES / "integrators.toml")
+    assert np.allclose(world.gravity, 0.0) and world.linear_drag > 0.0
+    n, radius = len(world.spheres), float(np.median(world.spheres.radii))
+    runs = {}
+    for name in ("euler", "rk2", "rk4"):
+        traj, _, _ = simulate_csv(tmp_path, "integrators", "--integrator", name, "--duration", "5")
+        runs[name] = traj.reshape(-1, n, 15)
+    times = runs["rk4"][:, 0, 0]
+    one, five = np.argmin(np.abs(times - 1.0)), len(times) - 1
+    assert times[five] == pytest.approx(5.0, abs=0.04)
+    for name in ("euler", "rk2"):
+        apart = np.linalg.norm(runs[name][:, :, 2:5] - runs["rk4"][:, :, 2:5], axis=2)
+        assert apart[one].max() < 0.05, name
+        assert np.median(apart[five]) > 2 * radius, (name, apart[five])
+    # all three lose energy to the drag only: the walls and balls are perfectly elastic and smooth
+    speeds = {k: np.linalg.norm(r[:, :, 5:8], axis=2) for k, r in runs.items()}
+    assert all((s[five] ** 2).sum() < (s[0] ** 2).sum() for s in speeds.values())
 
 
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):

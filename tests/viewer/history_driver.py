@@ -262,7 +262,46 @@ def replay_refuses_reaching_in(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in)}
+def integrator_ghosts_part_ways(workdir: Path) -> dict:
+    """The bundled integrators scene: F1 names it beside G; G, then X; where the ghosts are, against
+    their balls, in metres and in window pixels, 1 s and 5 s into the drop."""
+    from ballpit.viewer.hud import help_text
+
+    scene = Path(sys.argv[3])
+    viewer = wd.open_viewer(size=(640, 360), scene_path=scene)
+    sim = viewer.sim
+    wd.press(viewer, "F1")
+    out: dict = {"help_shown": viewer.hud.show_help, "help": help_text()}
+    wd.press(viewer, "F1")
+    wd.press(viewer, "G")
+    wd.press(viewer, "X")
+    radius = float(np.median(sim.world.spheres.radii))
+    out["radius"] = radius
+    for seconds in (1.0, 5.0):
+        while sim.world.time < seconds - 1e-9:
+            wd.pump(viewer, 1, dt=sim.timestep)  # one step a frame
+        main = np.asarray(sim.world.spheres.positions)
+        pixels, depth = viewer.camera.project(main, 640, 360)
+        focal = 180 / np.tan(np.radians(viewer.camera.fov_y_degrees / 2))
+        at: dict = {"time": float(sim.world.time), "drawn_radius": float(np.median(radius / depth * focal))}
+        for name, ghost in sim.timeline.ghost_worlds():
+            theirs = np.asarray(ghost.spheres.positions)
+            ghost_pixels, _ = viewer.camera.project(theirs, 640, 360)
+            at[name] = {
+                "metres": np.linalg.norm(theirs - main, axis=1).tolist(),
+                "pixels": np.linalg.norm(ghost_pixels - pixels, axis=1).tolist(),
+                "time": float(ghost.time),
+            }
+        wd.pump(viewer, 1, dt=0.0)
+        at["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
+        out[f"t{seconds:g}"] = at
+    return out
+
+
+SCENARIOS = {
+    f.__name__: f
+    for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in, integrator_ghosts_part_ways)
+}
 
 
 def main() -> None:
