@@ -113,7 +113,8 @@ def test_b_and_dragging_a_ball_in_a_replay_are_refused_with_a_message_and_the_re
 def test_the_integrators_scene_shows_the_ghosts_apart_from_their_balls(xvfb, tmp_path):
     r = run_scenario(xvfb, "integrator_ghosts_part_ways", tmp_path, str(REPO / "scenes" / "integrators.toml"))
     assert r["help_shown"] and "ballpit view integrators" in r["help"]
-    assert next(line for line in r["help"].splitlines() if "integrators" in line).lstrip().startswith("G ")
+    named = next(line for line in r["help"].splitlines() if "integrators" in line)  # beside G
+    assert named.startswith("1 / 2 / 3, G ") and "ghosts" in named
     radius = r["radius"]
     early, late = r["t1"], r["t5"]
     for name in ("euler", "rk2"):  # the scene runs RK4; G shows the other two
