@@ -1,19 +1,23 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
 # `make check` is the inner loop: lint, format and the tests marked neither slow nor window (< 1 min).
+# demo installs only what ballpit itself needs; test adds the test tools (pytest, ruff, scipy, ...).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 
 .PHONY: demo check test lint format bench clean
 
-$(VENV)/.installed: pyproject.toml
+$(VENV)/.ballpit: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed: $(VENV)/.ballpit
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $@
 
 # With no display the viewer prints how to render offscreen instead; that is not a failure here.
-demo: $(VENV)/.installed
+demo: $(VENV)/.ballpit
 	@$(VENV)/bin/ballpit || { status=$$?; [ -z "$$DISPLAY" ] && [ $$status -eq 1 ] || exit $$status; }
 
 check: $(VENV)/.installed
@@ -34,7 +38,7 @@ format: $(VENV)/.installed
 	$(VENV)/bin/ruff format .
 	$(VENV)/bin/ruff check --fix .
 
-bench: $(VENV)/.installed
+bench: $(VENV)/.ballpit
 	$(VENV)/bin/ballpit bench
 
 clean:

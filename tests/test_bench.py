@@ -80,3 +80,32 @@ def test_bench_times_the_slopes_demo_with_its_own_five_balls(capsys):
     table = [line.split() for line in capsys.readouterr().out.splitlines() if line.startswith("ballpit  ")]
     assert [(r[1], int(r[2]), int(r[3])) for r in table] == [("slopes", 5, 3)]
     assert float(table[0][4]) > 0
+
+
+def test_bench_help_says_its_whole_first_sentence(capsys):
+    with pytest.raises(SystemExit) as exc:
+        bench.main(["--help"])
+    assert exc.value.code == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "a pile at rest, and the slopes demo." in help_text
+
+
+@pytest.mark.parametrize(
+    "seconds",
+    [(0.16, 0.19), (0.01, 20.0)],  # step times within one decade (the axis labels 1.75), and across four
+    ids=["one decade", "four decades"],
+)
+def test_the_bench_plot_labels_its_axes_with_plain_numbers(seconds):
+    results = [
+        bench.Result("ballpit", "pile", n, 100, s, 0.0) for n, s in zip((1000, 100_000), seconds, strict=True)
+    ]
+    fig = bench.figure(results)
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    for axis in (ax.xaxis, ax.yaxis):
+        labels = [t.get_text() for t in axis.get_majorticklabels() + axis.get_minorticklabels()]
+        labels = [label for label in labels if label]
+        assert len(labels) >= 2
+        for label in labels:  # "1.75", "0.1", "10,000": no mathtext, no ×10ⁿ
+            assert float(label.replace(",", "")) > 0, label
+    assert "100,000" in [t.get_text() for t in ax.xaxis.get_majorticklabels()]

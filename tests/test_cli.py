@@ -11,6 +11,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -282,20 +284,11 @@ def test_duration_that_is_not_a_whole_number_of_steps_ends_exactly(tmp_path):
 def interrupt_while_writing(args: list, folder: Path) -> tuple[int, str]:
     """Run ``ballpit ARGS`` from the repository and press Ctrl+C once it is writing into ``folder`` (a
     ``.partial`` file there) and half a second into its steps; its exit status and stderr."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "ballpit", *map(str, args)], cwd=ROOT,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 60
-        while not any(p.name.endswith(".partial") for p in folder.iterdir()) and time.monotonic() < deadline:
-            time.sleep(0.05)
+    with running(*args) as proc:
+        wait_for(lambda: any(p.name.endswith(".partial") for p in folder.iterdir()))
         time.sleep(0.5)  # now inside the stepping loop
         proc.send_signal(signal.SIGINT)
         _, stderr = proc.communicate(timeout=60)
-    finally:
-        proc.kill()  # a run that outlives a failed test must not keep stepping (no-op once it has exited)
-        proc.wait()
     return proc.returncode, stderr
 
 
@@ -383,31 +376,45 @@ def test_a_file_name_of_255_bytes_is_written(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == [name]
 
 
-STARTED: list[subprocess.Popen] = []
+def _die_with_parent(then=None):
+    """A ``preexec_fn``: the child gets SIGKILL when the test process dies (Linux ``PR_SET_PDEATHSIG``),
+    even killed outright where no ``finally`` runs; then ``then()``."""
+
+    def setup() -> None:
+        import ctypes
+
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if then is not None:
+            then()
+
+    return setup
 
 
-def start(*args: str | Path, **kwargs) -> subprocess.Popen:
-    proc = subprocess.Popen(
+def start(*args: str | Path, preexec_fn=None, **kwargs) -> subprocess.Popen:
+    """``ballpit ARGS`` in the background, from the repository; it dies with the test process."""
+    return subprocess.Popen(
         [sys.executable, "-m", "ballpit", *map(str, args)],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_die_with_parent(preexec_fn) if sys.platform == "linux" else preexec_fn,
         **kwargs,
     )
-    STARTED.append(proc)
-    return proc
 
 
-@pytest.fixture(autouse=True)
-def _no_run_outlives_its_test():
-    """A process ``start`` began is killed when its test ends (it has exited already unless the test
-    failed), so a failed test leaves no run stepping on."""
-    yield
-    while STARTED:
-        proc = STARTED.pop()
-        proc.kill()
-        proc.wait()
+@contextmanager
+def running(*args: str | Path, **kwargs) -> Iterator[subprocess.Popen]:
+    """``ballpit ARGS`` started in the background (``start``), killed on the way out if it is still
+    running: a test that fails or times out must not leave its 60 s run behind."""
+    proc = start(*args, **kwargs)
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()  # reap it and close its pipes
 
 
 def wait_for(condition, timeout: float = 60) -> None:
@@ -417,15 +424,56 @@ def wait_for(condition, timeout: float = 60) -> None:
         time.sleep(0.05)
 
 
+def test_a_background_run_is_killed_when_its_test_fails_or_times_out():
+    with pytest.raises(subprocess.TimeoutExpired), running("simulate", "scenes/pile10k.toml",
+                                                          "--duration", "60", "-q") as proc:  # fmt: skip
+        proc.communicate(timeout=0.5)  # as a test waiting on a run that is too slow
+    assert proc.returncode == -signal.SIGKILL  # killed and reaped: nothing left running
+    with pytest.raises(ProcessLookupError):
+        os.kill(proc.pid, 0)
+    with pytest.raises(AssertionError), running("simulate", "scenes/pile10k.toml", "--duration", "60",
+                                                "-q") as proc:  # fmt: skip
+        wait_for(lambda: False, timeout=0.2)  # a condition that never comes
+    assert proc.returncode == -signal.SIGKILL
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="PR_SET_PDEATHSIG is Linux's")
+def test_a_background_run_dies_with_a_test_process_that_is_killed_outright(tmp_path):
+    """As when a time limit kills pytest itself: no ``finally`` runs, and still nothing is left."""
+    code = (
+        "import sys, time; sys.path.insert(0, sys.argv[1]); from tests.test_cli import start; "
+        "p = start('simulate', 'scenes/pile10k.toml', '--duration', '60', '-q'); "
+        "print(p.pid, flush=True); time.sleep(600)"
+    )
+    parent = subprocess.Popen([sys.executable, "-c", code, str(ROOT)], stdout=subprocess.PIPE, text=True)
+    try:
+        child = int(parent.stdout.readline())
+        os.kill(child, 0)  # running
+        parent.kill()
+        parent.wait(timeout=10)
+
+        def gone() -> bool:
+            try:
+                os.kill(child, 0)
+            except ProcessLookupError:
+                return True
+            return Path(f"/proc/{child}/stat").read_text().split(") ")[1].startswith("Z")  # a zombie: dead
+
+        wait_for(gone, timeout=10)
+    finally:
+        parent.kill()
+        parent.communicate()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_or_sighup_during_simulate_leaves_no_partial_file(tmp_path, signum):
     out, ev = tmp_path / "t.npz", tmp_path / "e.csv"
-    proc = start("simulate", "scenes/pile.toml", "--duration", "60", "--out", out, "--events", ev)
-    wait_for(lambda: sum(p.name.endswith(".partial") for p in tmp_path.iterdir()) == 2)
-    time.sleep(1.0)  # inside the stepping loop, with the writers open
-    proc.send_signal(signum)
-    _, stderr = proc.communicate(timeout=60)
+    with running("simulate", "scenes/pile10k.toml", "--duration", "60", "--out", out, "--events", ev) as proc:
+        wait_for(lambda: sum(p.name.endswith(".partial") for p in tmp_path.iterdir()) == 2)
+        time.sleep(1.0)  # inside the stepping loop, with the writers open
+        proc.send_signal(signum)
+        _, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 128 + signum, stderr
     assert stderr.strip().splitlines()[-1] == f"ballpit: stopped by {signal.Signals(signum).name}"
     assert "Traceback" not in stderr
@@ -443,8 +491,9 @@ def _limit_file_size() -> None:
 def test_a_write_that_fails_part_way_leaves_nothing(tmp_path, suffix):
     """A file size limit makes the writes fail part way as a full disk does: one line, exit 1, no file."""
     out = tmp_path / f"t.{suffix}"
-    proc = start("simulate", "scenes/pile.toml", "--duration", "1", "--out", out, preexec_fn=_limit_file_size)
-    _, stderr = proc.communicate(timeout=120)
+    with running("simulate", "scenes/pile.toml", "--duration", "1", "--out", out,
+                 preexec_fn=_limit_file_size) as proc:  # fmt: skip
+        _, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 1, stderr
     assert "Traceback" not in stderr
     assert stderr.strip().splitlines() == [
@@ -484,12 +533,11 @@ def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
     keep.parent.mkdir()
     keep.write_text("mine\n")
     for folder in (tmp_path / "frames", tmp_path / "new" / "frames"):
-        proc = start(
-            "render", "scenes/slopes.toml", "--out", f"{folder}/", "--duration", "5", "--size", "64x48"
-        )
-        wait_for(lambda f=folder: f.is_dir() and len(list(f.glob("frame_*.png"))) >= 5)
-        proc.send_signal(signal.SIGINT)
-        _, stderr = proc.communicate(timeout=60)
+        args = ["render", "scenes/slopes.toml", "--out", f"{folder}/", "--duration", "5", "--size", "64x48"]
+        with running(*args) as proc:
+            wait_for(lambda f=folder: f.is_dir() and len(list(f.glob("frame_*.png"))) >= 5)
+            proc.send_signal(signal.SIGINT)
+            _, stderr = proc.communicate(timeout=60)
         assert proc.returncode == 130, stderr
         assert stderr.strip().splitlines()[-1] == "ballpit: interrupted"
     assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == [
@@ -506,3 +554,35 @@ def test_render_into_a_path_through_a_file_is_one_line(tmp_path):
     r = ballpit("render", "scenes/slopes.toml", "--out", tmp_path / ("a" * 300 + ".gif"))
     assert_user_error(r, "--out", "304 bytes")
     assert [p.name for p in tmp_path.iterdir()] == ["notadir"]
+
+
+# ballpit as installed without the plot extra: matplotlib cannot be imported.
+WITHOUT_MATPLOTLIB = (
+    "import sys; sys.modules['matplotlib'] = None; from ballpit.cli import main; sys.exit(main(sys.argv[1:]))"
+)
+
+
+def without_matplotlib(*args: str | Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-c", WITHOUT_MATPLOTLIB, *map(str, args)],
+        capture_output=True, text=True, cwd=ROOT, timeout=timeout,
+    )  # fmt: skip
+
+
+def test_without_matplotlib_the_viewers_commands_run_and_plot_options_say_what_to_install(tmp_path):
+    # what the viewer and the headless runner need works without it
+    r = without_matplotlib("simulate", "scenes/slopes.toml", "--duration", "0.1", "--out", tmp_path / "t.csv")
+    assert r.returncode == 0, r.stderr
+    r = without_matplotlib("render", "scenes/slopes.toml", "--out", tmp_path / "f.png", "--duration", "0.1",
+                           "--size", "64x48")  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "f.png").is_file()
+    # --plot is refused up front, in one line naming the extra, before any run
+    png = tmp_path / "e.png"
+    for args in (["simulate", "scenes/slopes.toml", "--duration", "30"], ["compare", "scenes/slopes.toml"]):
+        r = without_matplotlib(*args, "--plot", png)
+        assert_user_error(r, "--plot needs matplotlib", "pip install 'ballpit[plot]'")
+    r = without_matplotlib("bench", "--workload", "free", "--sizes", "8", "--steps", "2", "--plot", png)
+    assert_user_error(r, "--plot needs matplotlib", "ballpit[plot]")
+    assert "steps/s" not in r.stdout  # nothing was measured first
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "t.csv"]

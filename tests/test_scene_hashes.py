@@ -24,6 +24,8 @@ pile10k, when its run was cut from 2 s to 0.7 s (#26: a faster suite): the 2 s r
 rest of the hash test together. 0.7 s still holds its landing: the first contact at step 128, then 40
 crowded steps with some 300,000 contacts. The new hash is that of the same code (it was checked on the
 commit before the change, and under the Sandybridge/no-AVX settings), not of a physics change.
+integrators, added (#23: a scene where Euler, RK2 and RK4 visibly part ways); its hash was the same
+with OpenBLAS's Sandybridge kernels and NumPy's AVX2/AVX512/FMA3 paths switched off.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ HASHES = {
     "gas": "79e162b84f53a910af613dc94d8d339dee9ff8d29570023a3c7c26e15d627db8",
     "pile": "2ed3ffe792a2939ca1568c0e2102c482cf23422cdcfb0fc49b05c31b04ff7091",
     "pile10k": "feb0619418b1d3857f890d4521d6d9f0872662ec7d664f0bdd08e24aa38a274a",
+    "integrators": "32f989f23c6d7c8d2f45df00b23ad46abd660e8028d24f1560c2201684005e1f",
     "seesaw": "62599274fca23f940b3383039e4887c86d7f9ad2a3f515d5c631e5fad3379d11",
 }
 

@@ -7,6 +7,7 @@ the way a user would check it.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,7 @@ from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw"}
+REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw", "integrators"}
 # Enough simulated time to exercise each scene while keeping the suite fast (big piles: a few steps).
 SHORT_RUN = {"pile": 3, "pile10k": 2, "gas": 3, "billiards": 20}  # steps
 DEFAULT_STEPS = 24
@@ -84,6 +85,33 @@ def test_piles_pour_into_a_box(name, at_least):
     assert (np.abs(pos[:, [0, 2]]) < half).all() and (pos[:, 1] > 0).all()
 
 
+MULTIPLES = {"twice": 2, "three times": 3, "four times": 4, "five times": 5, "six times": 6,
+             "seven times": 7, "eight times": 8, "nine times": 9, "ten times": 10}  # fmt: skip
+
+
+def test_ballpit_scenes_states_true_ball_counts():
+    """Every count ``ballpit scenes`` gives ("1,200 balls", "the 1,200-ball pile.toml", "eight times
+    over" another scene) is what the scenes hold."""
+    r = ballpit("scenes")
+    assert r.returncode == 0, r.stderr
+    counts = {p.stem: len(load_scene(p).spheres) for p in bundled_scenes()}
+    checked = 0
+    for line in r.stdout.splitlines():
+        name, text = line.split(None, 1)
+        number = r"(\d{1,3}(?:,\d{3})+|\d+)"
+        for n in re.findall(number + r"(?=(?: [a-z]+,?){0,3} balls\b)", text):
+            assert int(n.replace(",", "")) == counts[name], line
+            checked += 1
+        for n, other in re.findall(number + r"-ball (\w+)\.toml", text):
+            assert int(n.replace(",", "")) == counts[other], line
+            checked += 1
+        for other in re.findall(r"(\w+)\.toml", text):
+            for words, k in MULTIPLES.items():
+                if words in text:
+                    assert k * counts[other] == counts[name], line
+    assert checked >= 3  # gas, pile and pile10k at least
+
+
 def test_incline_balls_accelerate_as_the_textbook_says(tmp_path):
     traj, _, _ = simulate_csv(tmp_path, "incline", "--duration", "1.0")
     vx = traj[-4:, 5]  # the four balls at t = 1 s
@@ -103,6 +131,29 @@ def test_cradle_passes_momentum_down_the_line(tmp_path):
 
 
 @pytest.mark.slow
+def test_integrators_agree_at_first_then_part_ways(tmp_path):
+    """The integrators demo, judged from ``ballpit simulate --integrator`` output: drag is the only force
+    that changes within a step, so the three runs agree to millimetres for the first second; the
+    balls' meetings then multiply the difference until Euler's and RK2's balls are far from RK4's."""
+    world = load_scene(SCENES / "integrators.toml")
+    assert np.allclose(world.gravity, 0.0) and world.linear_drag > 0.0
+    n, radius = len(world.spheres), float(np.median(world.spheres.radii))
+    runs = {}
+    for name in ("euler", "rk2", "rk4"):
+        traj, _, _ = simulate_csv(tmp_path, "integrators", "--integrator", name, "--duration", "5")
+        runs[name] = traj.reshape(-1, n, 15)
+    times = runs["rk4"][:, 0, 0]
+    one, five = np.argmin(np.abs(times - 1.0)), len(times) - 1
+    assert times[five] == pytest.approx(5.0, abs=0.04)
+    for name in ("euler", "rk2"):
+        apart = np.linalg.norm(runs[name][:, :, 2:5] - runs["rk4"][:, :, 2:5], axis=2)
+        assert apart[one].max() < 0.05, name
+        assert np.median(apart[five]) > 2 * radius, (name, apart[five])
+    # all three lose energy to the drag only: the walls and balls are perfectly elastic and smooth
+    speeds = {k: np.linalg.norm(r[:, :, 5:8], axis=2) for k, r in runs.items()}
+    assert all((s[five] ** 2).sum() < (s[0] ** 2).sum() for s in speeds.values())
+
+
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):
     """The see-saw demo, judged from ``ballpit simulate`` output: the balls land on the plank, roll
     left (downhill), turn back as it tips over, and leave its right end for the floor."""

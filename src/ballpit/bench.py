@@ -214,10 +214,23 @@ def _table(results: list[Result], reference: dict[tuple[str, int], Result]) -> s
 
 
 def _plot(results: list[Result], path: str) -> None:
+    figure(results).savefig(path, dpi=120)
+    print(f"wrote {path}")
+
+
+def figure(results: list[Result]) -> object:
+    """The log-log plot of step time against N (a matplotlib Figure), labelled with plain numbers."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    class PlainLog(LogFormatterSciNotation):
+        """Labels where matplotlib's log axis puts them, written 1.75, 0.5 or 10,000, not 1.75×10⁰."""
+
+        def __call__(self, x: float, pos: int | None = None) -> str:
+            return f"{x:,.10g}" if super().__call__(x, pos) else ""
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for engine in sorted({r.engine for r in results}):
@@ -232,13 +245,15 @@ def _plot(results: list[Result], path: str) -> None:
                     "o-",
                     label=f"{engine} {workload}",
                 )
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(PlainLog())
+        axis.set_minor_formatter(PlainLog(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
     ax.set_xlabel("balls")
     ax.set_ylabel("ms per step")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    print(f"wrote {path}")
+    return fig
 
 
 MAX_TIMEOUT = 1e6  # s (11.6 days): the wait for a child is kept in int milliseconds (at most 24.8 days)
@@ -264,7 +279,8 @@ def _sizes(text: str) -> list[int]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = OneLineParser(prog="ballpit bench", description=__doc__.splitlines()[0])
+    description = " ".join(__doc__.split("\n\n")[0].split())  # the first paragraph, whole
+    parser = OneLineParser(prog="ballpit bench", description=description)
     parser.add_argument(
         "--workload",
         choices=("free", "pile", "settled", "slopes", "all"),
@@ -289,6 +305,11 @@ def main(argv: list[str] | None = None) -> int:
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )
     args = parser.parse_args(argv)
+    if args.plot and not args.one:
+        from .plots import MISSING_MATPLOTLIB, have_matplotlib
+
+        if not have_matplotlib():  # say so now, not after the measurements
+            parser.error(f"--plot {MISSING_MATPLOTLIB}")
 
     if args.one:
         keep_freed_memory()  # as the app runs the engine (allocator.py)

@@ -2,8 +2,8 @@
 
 ``PlotFile`` checks the path and opens a temporary file beside it before the run starts, so a bad
 or unwritable path fails at once; the figure is drawn into the temporary file at the end and renamed
-into place, so a failed or interrupted run leaves no partial image. matplotlib is imported only when
-a figure is drawn.
+into place, so a failed or interrupted run leaves no partial image. matplotlib is an optional
+dependency (``pip install 'ballpit[plot]'``): ``PlotFile`` says so up front when it is missing.
 """
 
 from __future__ import annotations
@@ -26,10 +26,24 @@ INTEGRATOR_STYLE = {name: {"color": integrator.colour} for name, integrator in I
 REFERENCE_STYLE = {"color": "0.35", "linestyle": "--"}
 
 
+MISSING_MATPLOTLIB = "needs matplotlib, which is not installed: pip install 'ballpit[plot]'"
+
+
+def have_matplotlib() -> bool:
+    """Whether matplotlib can be imported (it is the ``plot`` extra, not a core dependency)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 class PlotFile:
     """A figure file: checked and opened (as a temporary file beside it) now, written on ``commit``."""
 
     def __init__(self, path: Path, what: str = "--plot") -> None:
+        if not have_matplotlib():
+            raise OutputError(f"{what} {MISSING_MATPLOTLIB}")
         suffix = path.suffix.lower()
         if suffix not in PLOT_FORMATS:
             raise OutputError(

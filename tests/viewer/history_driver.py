@@ -214,7 +214,95 @@ def replay(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (history_keys, ghosts_and_plot, replay)}
+def replay_refuses_reaching_in(workdir: Path) -> dict:
+    """B (a real X key press) and a real pointer drag on a ball, in a replay: each is refused with a
+    message, and the replay plays on frame by frame as recorded."""
+    from ballpit.viewer.replay import read_trajectory
+
+    scene = Path(sys.argv[3])
+    trajectory = read_trajectory(workdir / sys.argv[4])
+    viewer = wd.open_viewer(size=(640, 360), scene_path=scene, trajectory=trajectory)
+    sim = viewer.sim
+    rp = sim.timeline.replay
+
+    def frame_matches() -> bool:
+        return bool(np.array_equal(np.asarray(sim.world.spheres.positions), trajectory.position[rp.current]))
+
+    def state() -> dict:
+        return {"frame": rp.current, "matches": frame_matches(), "balls": sim.ball_count,
+                "phase": sim.phase.name, "error": sim.error}  # fmt: skip
+
+    wd.pump(viewer, 10)
+    wd.point_at(viewer)
+    out: dict = {"before": state()}
+    wd.xdotool("key", "b")
+    wd.settle(viewer)
+    out["b_message"] = wd.shown_message(viewer)
+    wd.pump(viewer, 30)  # 0.5 s more of the replay
+    out["after_b"] = state()
+
+    wd.press(viewer, "SPACE")  # paused, so the ball stays under the pointer
+    at = state()
+    pixels, _ = viewer.camera.project(np.asarray(sim.world.spheres.positions)[:1], 640, 360)
+    x, y = (int(v) for v in pixels[0])  # ball 0's centre, from the top-left corner
+    wid = str(viewer.window._window)
+    wd.xdotool("mousemove", "--window", wid, str(x), str(y))
+    wd.settle(viewer, 3)
+    wd.xdotool("mousedown", "1")
+    wd.settle(viewer, 3)
+    wd.xdotool("mousemove", "--window", wid, str(x + 60), str(y - 40))
+    wd.settle(viewer, 3)
+    out["drag_message"] = wd.shown_message(viewer)
+    out["held"] = viewer.interaction.held_ball
+    wd.xdotool("mouseup", "1")
+    wd.settle(viewer, 3)
+    out["paused_at"], out["after_drag"] = at, state()
+    wd.press(viewer, "SPACE")
+    wd.pump(viewer, 30)
+    out["resumed"] = state()
+    return out
+
+
+def integrator_ghosts_part_ways(workdir: Path) -> dict:
+    """The bundled integrators scene: F1 names it beside G; G, then X; where the ghosts are, against
+    their balls, in metres and in window pixels, 1 s and 5 s into the drop."""
+    from ballpit.viewer.hud import help_text
+
+    scene = Path(sys.argv[3])
+    viewer = wd.open_viewer(size=(640, 360), scene_path=scene)
+    sim = viewer.sim
+    wd.press(viewer, "F1")
+    out: dict = {"help_shown": viewer.hud.show_help, "help": help_text()}
+    wd.press(viewer, "F1")
+    wd.press(viewer, "G")
+    wd.press(viewer, "X")
+    radius = float(np.median(sim.world.spheres.radii))
+    out["radius"] = radius
+    for seconds in (1.0, 5.0):
+        while sim.world.time < seconds - 1e-9:
+            wd.pump(viewer, 1, dt=sim.timestep)  # one step a frame
+        main = np.asarray(sim.world.spheres.positions)
+        pixels, depth = viewer.camera.project(main, 640, 360)
+        focal = 180 / np.tan(np.radians(viewer.camera.fov_y_degrees / 2))
+        at: dict = {"time": float(sim.world.time), "drawn_radius": float(np.median(radius / depth * focal))}
+        for name, ghost in sim.timeline.ghost_worlds():
+            theirs = np.asarray(ghost.spheres.positions)
+            ghost_pixels, _ = viewer.camera.project(theirs, 640, 360)
+            at[name] = {
+                "metres": np.linalg.norm(theirs - main, axis=1).tolist(),
+                "pixels": np.linalg.norm(ghost_pixels - pixels, axis=1).tolist(),
+                "time": float(ghost.time),
+            }
+        wd.pump(viewer, 1, dt=0.0)
+        at["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
+        out[f"t{seconds:g}"] = at
+    return out
+
+
+SCENARIOS = {
+    f.__name__: f
+    for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in, integrator_ghosts_part_ways)
+}
 
 
 if __name__ == "__main__":

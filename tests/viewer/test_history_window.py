@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ballpit.physics import INTEGRATOR_NAMES
@@ -95,3 +96,40 @@ def test_a_simulate_trajectory_replays_with_pause_step_scrub_and_time_scale(xvfb
     assert scale == 2.0 and elapsed == pytest.approx(1.0, abs=0.02) and matches  # 0.5 s of frames at ×2
     assert r["end"] == [480, 480, "PAUSED"]
     assert "replay      run.npz" in r["hud"]
+
+
+def test_b_and_dragging_a_ball_in_a_replay_are_refused_with_a_message_and_the_replay_plays_on(
+    xvfb, tmp_path, slopes_run
+):
+    r = run_scenario(
+        xvfb, "replay_refuses_reaching_in", tmp_path, str(REPO / "scenes" / "slopes.toml"), slopes_run.name
+    )
+    assert r["before"]["phase"] == "RUNNING" and r["before"]["balls"] == 5
+    assert "not available in a replay" in r["b_message"]
+    after = r["after_b"]
+    assert after["balls"] == 5 and after["error"] is None and after["phase"] == "RUNNING"
+    assert after["frame"] >= r["before"]["frame"] + 100 and after["matches"]  # 0.5 s more, as recorded
+    assert "not available in a replay" in r["drag_message"] and r["held"] is None
+    assert r["after_drag"] == r["paused_at"] and r["after_drag"]["matches"]  # nothing moved
+    resumed = r["resumed"]
+    assert resumed["frame"] >= r["paused_at"]["frame"] + 100 and resumed["matches"]
+    assert resumed["error"] is None and resumed["balls"] == 5
+
+
+def test_the_integrators_scene_shows_the_ghosts_apart_from_their_balls(xvfb, tmp_path):
+    r = run_scenario(xvfb, "integrator_ghosts_part_ways", tmp_path, str(REPO / "scenes" / "integrators.toml"))
+    assert r["help_shown"] and "ballpit view integrators" in r["help"]
+    named = next(line for line in r["help"].splitlines() if "integrators" in line)  # beside G
+    assert named.startswith("1 / 2 / 3, G ") and "ghosts" in named
+    radius = r["radius"]
+    early, late = r["t1"], r["t5"]
+    for name in ("euler", "rk2"):  # the scene runs RK4; G shows the other two
+        # 1 s in, each ghost still covers its ball (under 5 cm apart)...
+        assert early[name]["time"] == early["time"] and max(early[name]["metres"]) < 0.05
+        # ...and by 5 s most have left it: more than a ball's width away, in the world and on screen
+        metres, pixels = np.array(late[name]["metres"]), np.array(late[name]["pixels"])
+        assert late[name]["time"] == late["time"] == pytest.approx(5.0, abs=0.05)
+        assert np.median(metres) > 2 * radius, metres
+        assert np.median(pixels) > 2 * late["drawn_radius"], pixels
+    calls = dict((label, n) for label, n in late["calls"])
+    assert calls["balls"] == 8 and calls["ghosts"] == 16  # both ghost sets are drawn

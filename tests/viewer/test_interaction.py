@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+import ballpit
+from ballpit.scene import read_scene
 from ballpit.viewer.camera import Camera
-from ballpit.viewer.interaction import SHOT_SPEEDS, TILT_RATE, Interaction
+from ballpit.viewer.interaction import SHOT_SPEEDS, TILT_RATE, Interaction, typical_material
 from ballpit.viewer.simulation import Phase, Simulation
 
-from .conftest import line_of_balls
+from .conftest import REPO, line_of_balls
 
 
 def test_a_shot_ball_grows_everything_kept_per_ball_and_reset_drops_it_again():
@@ -26,6 +29,30 @@ def test_a_shot_ball_grows_everything_kept_per_ball_and_reset_drops_it_again():
     assert (
         sim.ball_count == 3 and len(sim.appearance.sphere_colors) == 3 and len(sim.world.spheres.masses) == 3
     )
+
+
+def test_a_shot_ball_is_made_of_the_scenes_material_and_rolls_to_a_stop_at_five_sevenths_rho_g():
+    sim = Simulation(read_scene(REPO / "scenes" / "slopes.toml"))  # every ball: e 1, mu 0.5, rho 0.3
+    camera = Camera.looking_at((0.0, 0.25, 3.0), (0.0, 0.25, 10.0))  # eye at a ball's height, level
+    ball = sim.world.spheres[Interaction(sim).shoot(camera)]  # starts on the ground, away from the slopes
+    assert (ball.restitution, ball.friction, ball.rolling_friction) == (1.0, 0.5, 0.3)
+    speeds = []
+    for _ in range(4 * 240):  # 4 s
+        sim.world.step(sim.timestep)
+        speeds.append(float(np.linalg.norm(ball.velocity)))
+    # rolling on the ground (rho 0.3 too): it slows at (5/7)·rho·g with rho = sqrt(0.3·0.3)
+    assert speeds[round(1.5 * 240)] - speeds[round(2.5 * 240)] == pytest.approx(5 / 7 * 0.3 * 9.81, rel=1e-3)
+    assert speeds[-1] < 1e-9 and ball.position[2] < 20.0  # at rest after about 14 m, not rolling for ever
+
+
+def test_the_typical_material_is_the_most_common_one_and_the_first_on_a_tie():
+    world = line_of_balls(1)
+    for e, mu, rho in ((0.9, 0.4, 0.1), (0.5, 0.2, 0.0), (0.5, 0.2, 0.0), (0.9, 0.4, 0.1)):
+        world.add_sphere(position=(0, 9, 0), radius=0.1, restitution=e, friction=mu, rolling_friction=rho)
+    assert typical_material(world.spheres) == {"restitution": 0.9, "friction": 0.4, "rolling_friction": 0.1}
+    world.add_sphere(position=(0, 9, 0), radius=0.1, restitution=0.5, friction=0.2)
+    assert typical_material(world.spheres) == {"restitution": 0.5, "friction": 0.2, "rolling_friction": 0.0}
+    assert typical_material(ballpit.World().spheres) == {}
 
 
 def test_shift_b_steps_round_the_shot_speeds():

@@ -3,8 +3,10 @@ and loads back (``ballpit check`` too) into the same World as the one saved."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
+from datetime import UTC, datetime
 
 import numpy as np
 import pytest
@@ -13,7 +15,7 @@ from scipy.spatial.transform import Rotation
 import ballpit
 from ballpit.scene import read_scene
 from ballpit.viewer.camera import Camera
-from ballpit.viewer.save import euler_xyz_degrees, save_scene, saved_path
+from ballpit.viewer.save import ROUND_OFF, SAVED_MARK, euler_xyz_degrees, save_scene, saved_path, scene_text
 from ballpit.viewer.simulation import Simulation
 
 from .conftest import subprocess_env
@@ -62,11 +64,18 @@ def _states(world) -> dict[str, np.ndarray]:
     }  # fmt: skip
 
 
+def assert_same_or_round_off(saved: np.ndarray, live: np.ndarray, key: str) -> None:
+    """The same doubles, except live round-off (under 1e-12 of a scene at most 1 km across), saved as 0."""
+    differ = saved != live
+    assert (saved[differ] == 0.0).all(), key
+    assert (np.abs(live[differ]) < 1e-9).all(), key
+
+
 def assert_same_world(saved, live) -> None:
     a, b = _states(saved), _states(live)
     for key in ("positions", "velocities", "angular_velocities", "radii", "masses", "ball_materials",
                 "plane_materials", "plane_motion", "half_sizes"):  # fmt: skip
-        assert np.array_equal(a[key], b[key]), key  # the same doubles
+        assert_same_or_round_off(a[key], b[key], key)
     assert np.allclose(a["orientations"], b["orientations"], rtol=0, atol=1e-15)  # renormalised on load
     for key in ("plane_centers", "plane_orientations", "plane_normals"):  # through Euler angles
         assert np.allclose(a[key], b[key], rtol=0, atol=1e-12), key
@@ -138,7 +147,8 @@ def test_saving_before_the_drop_keeps_the_untouched_tables_and_adds_the_new_ball
     saved = save_scene(sim, Camera.looking_at((0, 3, 10), (0, 1, 0)))
     text = saved.read_text()
     assert text.count("[[sphere]]") == 1 + 4 + 1  # the grid's balls load after all spheres: written out
-    assert text.startswith(SCENE.split("[camera]")[0])  # the untouched top, comments and all
+    body = text.partition("\n\n")[2]  # below the mark saying where it was saved from
+    assert body.startswith(SCENE.split("[camera]")[0])  # the untouched top, comments and all
     assert_same_world(ballpit.load_scene(saved), sim.world)
 
 
@@ -199,3 +209,67 @@ def test_an_untouched_scene_is_saved_without_an_overlap_tolerance(tmp_path):
     sim = Simulation(read_scene(path), path)
     saved = save_scene(sim, Camera.looking_at((1.0, 2.0, 8.0), (0.0, 1.0, 0.0)))
     assert "overlap_tolerance" not in saved.read_text()
+
+
+def _numbers(text: str) -> np.ndarray:
+    """Every number written in the TOML text's values (not in its comments)."""
+    values = []
+    for line in text.splitlines():
+        value = line.split("#", 1)[0].partition("=")[2]
+        values += [float(v) for v in re.findall(r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?", value)]
+    return np.array(values)
+
+
+def test_round_off_is_saved_as_zero_and_everything_else_exactly(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(ballpit.load_scene(path), path)
+    world = sim.world
+    world.planes[1].angular_velocity = (0.0, 0.0, 0.3)  # tilting it leaves round-off in its pose
+    for _ in range(300):
+        world.step(sim.timestep)
+    world.planes[1].angular_velocity = (0.0, 0.0, 0.0)
+    world.spheres[0].velocity = (2e-323, -3.55e-15, 1.5)  # as a run leaves them: a denormal, a cancellation
+    world.spheres[0].angular_velocity = (0.0, -1e-30, 4.0)
+    text = scene_text(sim, Camera.looking_at((0, 3, 10), (0, 1, 0)))
+    numbers = _numbers(text)
+    tiny = numbers[(numbers != 0.0) & (np.abs(numbers) < 1e-9)]
+    assert tiny.size == 0, tiny  # no 2e-323, no -3.55e-15: every scale here is at least 1
+    assert not re.search(r"-0\.0\b(?!\d)", text)  # no negative zeros either
+    saved = tmp_path / "saved.toml"
+    saved.write_text(text)
+    loaded = ballpit.load_scene(saved)
+    assert list(loaded.spheres[0].velocity) == [0.0, 0.0, 1.5]
+    assert list(loaded.spheres[0].angular_velocity) == [0.0, 0.0, 4.0]
+    assert_same_world(loaded, world)
+    assert ROUND_OFF == 1e-12
+
+
+def test_a_saved_file_says_what_it_was_saved_from_and_when_above_the_originals_comments(tmp_path):
+    path = tmp_path / "ramp.toml"
+    path.write_text(SCENE)
+    sim = Simulation(ballpit.load_scene(path), path)
+    for _ in range(240):
+        sim.world.step(sim.timestep)
+    now = datetime(2026, 12, 2, 9, 30, 5, tzinfo=UTC)
+    text = scene_text(sim, Camera.looking_at((0, 3, 10), (0, 1, 0)), now=now)
+    first, second, third, blank = text.splitlines()[:4]
+    assert first.startswith(SAVED_MARK + "ramp.toml") and "Ctrl+S" in first
+    local = now.astimezone()
+    assert local.strftime("%Y-%m-%d %H:%M:%S") in first and local.strftime("%Z") in first
+    assert second == "# 1.000 s into its run, integrator RK4."
+    assert "original's" in third and blank == ""
+    assert text.index("# A test scene") > text.index(third)  # the original's comments follow, kept
+    # saving the saved file again replaces the mark instead of piling marks up
+    saved = tmp_path / "ramp-saved-1.toml"
+    saved.write_text(text)
+    again = scene_text(Simulation(ballpit.load_scene(saved), saved), Camera(), now=now)
+    assert again.count(SAVED_MARK) == 1 and again.startswith(SAVED_MARK + "ramp-saved-1.toml")
+    assert "# 0.000 s into its run" in again and again.count("# A test scene") == 1
+
+
+def test_a_world_built_in_code_says_so_when_saved():
+    world = ballpit.World()
+    world.add_plane(position=(0, 0, 0))
+    text = scene_text(Simulation(world), Camera(), now=datetime(2026, 12, 2, 9, 30, 5))
+    assert text.startswith(SAVED_MARK + "a world built in code") and "original's" not in text

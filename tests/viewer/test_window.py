@@ -114,9 +114,14 @@ def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
     assert not under_hud.any()
     assert (x - radius >= 0).all() and (x + radius <= width).all()
     assert (y - radius >= 0).all() and (y + radius <= height).all()
-    # and the action fills the window from below the HUD to the bottom edge: no empty band of floor
-    assert (y + radius).max() > 0.9 * height
+    # nor under the timeline bar that appears with the drop along the bottom
+    assert r["bar_top"] < 0.95 * height
+    assert (y + radius <= r["bar_top"]).all()
+    # and the action fills the window down to the bar: no empty band of floor
+    assert (y + radius).max() > r["bar_top"] - 0.1 * height
     assert (y - radius).min() < 0.4 * height
+    # with balls drawn big enough to see their spin (the scene is 19 m wide; 0.5 m balls)
+    assert np.median(2 * radius) >= 24 and (2 * radius).min() >= 20
 
 
 def overlap(a: list[float], b: list[float]) -> bool:

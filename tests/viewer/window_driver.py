@@ -334,6 +334,7 @@ def slopes_framing(workdir: Path) -> dict:
         track.append(np.column_stack([pixels, radius]).tolist())
     out["track"] = track  # per frame, per ball: (x, y, radius) in pixels
     out["hud_after"] = hud_rectangle(viewer)
+    out["bar_top"] = out["size"][1] - viewer.screen.bottom_clearance()  # the timeline bar and its label
     return out
 
 

@@ -127,19 +127,19 @@ QUIT_HINT = "press Esc again to quit"
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
 
 HELP: tuple[tuple[str, str], ...] = (
-    ("X / Space", "start the drop (it waits for X) / pause"),
+    ("X / Space, + / −", "start the drop / pause; time faster / slower"),
     ("N or →", "single step while paused"),
     ("← / Shift+← →", "paused: step back / jump 1 s; or drag the bottom bar"),
     ("R / Ctrl+R or F5", "reset (X drops again) / reload (also on save)"),
     (
-        "/".join(i.key for i in INTEGRATORS.values()) + ", + / −",
-        "/".join(i.label for i in INTEGRATORS.values()) + "; faster/slower time",
+        "/".join(i.key for i in INTEGRATORS.values()) + ", G",
+        "/".join(i.label for i in INTEGRATORS.values()) + "; ghosts: view integrators",
     ),
     ("W A S D, Q E", "fly forward/left/back/right, down/up"),
     ("Shift", "fly faster; scroll changes fly speed"),
     ("right drag or Tab", "look around (Tab captures the mouse)"),
     ("Esc", "release the mouse, drop a plane; twice quits"),
-    ("C / V / T, G / P", "contacts, velocities, trails; ghosts, energy plot"),
+    ("C / V / T, P", "contacts, velocities, trails; energy plot"),
     ("H / F1 / F2", "HUD / this help / HUD page: time per stage"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),

@@ -41,7 +41,24 @@ TILT_KEYS: dict[str, tuple[str, float]] = {
     "RIGHT": ("forward", 1.0),
 }
 LIFT_KEYS: dict[str, float] = {"PAGEUP": 1.0, "PAGEDOWN": -1.0}
+# A replay writes recorded frames into the world: a ball added or moved there has no frames to follow.
+NOT_IN_REPLAY = "{} is not available in a replay: it plays a recorded run"
 PLANE_KEYS = frozenset(TILT_KEYS) | frozenset(LIFT_KEYS)
+
+
+def typical_material(spheres: object) -> dict[str, float]:
+    """The most common (restitution, friction, rolling friction) among ``spheres`` (the first of the
+    most common on a tie), as ``add_sphere`` arguments; {} when there are no balls (the defaults).
+
+    A shot ball made of it rolls to a stop where the scene's own balls do, rather than rolling on for
+    ever without the rolling friction they have."""
+    names = ("restitution", "friction", "rolling_friction")
+    if not len(spheres):  # type: ignore[arg-type]
+        return {}
+    rows = np.array([[getattr(ball, name) for name in names] for ball in spheres])  # type: ignore[attr-defined]
+    kinds, first, counts = np.unique(rows, axis=0, return_index=True, return_counts=True)
+    best = np.lexsort((first, -counts))[0]  # the most common, then the earliest
+    return dict(zip(names, (float(v) for v in kinds[best]), strict=True))
 
 
 class Interaction:
@@ -74,6 +91,8 @@ class Interaction:
         if hit.kind == "plane":
             self.select(hit.index)
             return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+        if self.in_replay:
+            return NOT_IN_REPLAY.format("dragging a ball")
         ball = self.sim.world.spheres[hit.index]
         centre = np.array(ball.position, dtype=float)
         grabbed = ray_plane_point(ray, centre, np.asarray(facing, dtype=float))
@@ -192,9 +211,13 @@ class Interaction:
         self.shot_speed = bigger[0] if bigger else SHOT_SPEEDS[0]
         return self.shot_speed
 
-    def shoot(self, camera: Camera) -> int:
-        """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index.
-        It is as big and heavy as the scene's typical (median) ball."""
+    def shoot(self, camera: Camera) -> int | None:
+        """B: a ball from just in front of the eye along the view at ``shot_speed``; returns its index
+        (None in a replay, where the HUD says B is not available).
+        It is as big and heavy as the scene's typical (median) ball, and made of its typical material."""
+        if self.in_replay:
+            self.sim.message = NOT_IN_REPLAY.format("B (shoot a ball)")
+            return None
         spheres = self.sim.world.spheres
         radius = float(np.median(spheres.radii)) if len(spheres) else SHOT_RADIUS
         mass = float(np.median(spheres.masses)) if len(spheres) else SHOT_MASS
@@ -202,10 +225,16 @@ class Interaction:
         start = np.asarray(camera.position, dtype=float) + forward * (2.0 * radius + camera.near)
         color = palette_colors(1, first=len(spheres))[0]
         return self.sim.add_ball(
-            color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed
-        )
+            color, position=start, radius=radius, mass=mass, velocity=forward * self.shot_speed,
+            **typical_material(spheres),
+        )  # fmt: skip
 
     # ------------------------------------------------------------------ state
+    @property
+    def in_replay(self) -> bool:
+        """Whether the window plays a recorded run (``view --replay``) instead of live physics."""
+        return self.sim.timeline.replay is not None
+
     def clear(self) -> None:
         """Reset hook: the world was replaced, so let go of everything (nothing to give back)."""
         self.held_ball = None
