@@ -240,6 +240,7 @@ def broken_reload(workdir: Path) -> dict:
 
     touch_later(scene, GOOD_SCENE + "\n[[sphere]]\nposition = [1, 3, 0]\nradius = 0.2\n")
     pump_until(viewer, lambda: viewer.sim.ball_count == 2)
+    pump(viewer, 2)  # the physics thread reloaded it: the window hears back on its next frames
     out["fixed_error"] = viewer.hud.error
     out["fixed_balls"] = sim.ball_count
     out["fixed_phase"] = sim.phase.name

@@ -52,6 +52,24 @@ class Framebuffer:
     def bind(self) -> None:
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.fbo)
 
+    def present(self, width: int, height: int) -> None:
+        """Copy the image into the window's back buffer, ``width`` x ``height`` pixels (scaled up
+        smoothly when the view is drawn at a lower resolution). Leaves the window's framebuffer bound."""
+        w, h = self.width, self.height
+        source = self.fbo
+        if self.resolve_fbo is not None:  # a multisampled image resolves only at its own size
+            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.fbo)
+            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.resolve_fbo)
+            GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+            source = self.resolve_fbo
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, 0)
+        same = (w, h) == (width, height)
+        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT,
+                             GL.GL_NEAREST if same else GL.GL_LINEAR)  # fmt: skip
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+        GL.glViewport(0, 0, width, height)
+
     def read(self) -> np.ndarray:
         """The rendered image, (height, width, 3) uint8, row 0 at the top."""
         source = self.fbo
