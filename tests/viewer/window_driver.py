@@ -428,6 +428,56 @@ def profile_page(workdir: Path) -> dict:
     return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page}
 
 
+def _bundled_viewer(name: str) -> Viewer:
+    """The bundled scene ``name`` in a default-sized window, its physics running free as in the app."""
+    from ballpit.scene import default_scene_path
+
+    viewer = Viewer(size=(1280, 720), scene_path=default_scene_path().with_name(name))
+    OPENED.append(viewer)
+    return viewer
+
+
+def _drop_and_land(viewer: Viewer, seconds: float) -> dict:
+    """X, then wait for the first step, then count frames drawn and steps taken for ``seconds``."""
+    from pyglet.window import key
+
+    pump_for(viewer, 0.5)
+    viewer.window.dispatch_event("on_key_press", key.X, 0)
+    pump_until(viewer, lambda: viewer.sim.steps_total > 0, timeout=30)
+    pump_for(viewer, 1.0)  # into the landing: the balls reach the floor
+    frames, steps, started = viewer.frames, viewer.sim.steps_total, time.perf_counter()
+    pump_for(viewer, seconds)
+    wall = time.perf_counter() - started
+    steps_per_second = (viewer.sim.steps_total - steps) / wall
+    return {"fps": (viewer.frames - frames) / wall, "steps_per_second": steps_per_second,
+            "caption": viewer.window.caption, "hud": viewer.hud.text}  # fmt: skip
+
+
+def pile_landing(workdir: Path) -> dict:
+    """pile.toml (1,200 balls) landing in real time: frames drawn against physics steps taken."""
+    return _drop_and_land(_bundled_viewer("pile.toml"), 4.0)
+
+
+def escape_mid_step(workdir: Path) -> dict:
+    """pile10k.toml landing in real time; Esc, Esc while a step runs: how long until the window closes."""
+    from pyglet.window import key
+
+    viewer = _bundled_viewer("pile10k.toml")
+    out = _drop_and_land(viewer, 1.0)
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    pump(viewer, 2, dt=None)
+    pump_until(viewer, lambda: viewer.physics.lock.locked(), timeout=10)  # a step is in progress
+    out["stepping_at_escape"] = viewer.physics.lock.locked()
+    pressed = time.perf_counter()
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    while not viewer.closed and time.perf_counter() - pressed < 10:
+        viewer.pump()
+    viewer.pump()  # outside pyglet's loop the window closes on the next pump
+    out["quit_seconds"] = time.perf_counter() - pressed
+    out["closed"] = viewer.closed
+    return out
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
@@ -442,6 +492,8 @@ SCENARIOS = {
         help_beside_hud,
         double_escape,
         profile_page,
+        pile_landing,
+        escape_mid_step,
     )
 }
 
