@@ -138,31 +138,20 @@ class Viewer:
 
     def set_quality(self, option: str) -> None:
         """``auto``, ``low`` or ``high`` (quality.py): MSAA, shadows and the view's resolution."""
+        from .framebuffer import WindowView
         from .quality import choose
 
-        self.quality = choose(option, self.renderer_name)
-        self.renderer.shadows = self.quality.shadow_limit > 0
-        self.renderer.shadow_limit = max(self.quality.shadow_limit, 1)
+        self.quality = q = choose(option, self.renderer_name)
+        self.renderer.shadows = q.shadow_limit > 0
+        self.renderer.shadow_limit = max(q.shadow_limit, 1)
         if self.view_target is not None:
+            self.window.switch_to()
             self.view_target.delete()
-            self.view_target = None
+        self.view_target = WindowView(q.samples, q.scale)
 
     @property
     def multisample(self) -> bool:
         return self.quality.samples > 0
-
-    def _target(self, width: int, height: int):
-        """The view's framebuffer for a window of ``width`` x ``height`` pixels (made again on resize)."""
-        from .framebuffer import Framebuffer
-
-        q = self.quality
-        size = (max(round(width * q.scale), 1), max(round(height * q.scale), 1))
-        target = self.view_target
-        if target is None or (target.width, target.height) != size:
-            if target is not None:
-                target.delete()
-            target = self.view_target = Framebuffer(*size, q.samples)
-        return target
 
     def _needs(self) -> Needs:
         """What the physics should copy for the window (asked at every hand-over)."""
@@ -424,10 +413,10 @@ class Viewer:
         self.feeder.upload(shown, self.flags, self.camera.position, self.interaction.lines())
         self.screen.upload(self.renderer)
         width, height = self.window.get_framebuffer_size()
-        target = self._target(width, height)
-        target.bind()
-        self.renderer.draw(self.camera, target.width, target.height, multisample=target.multisample)
-        target.present(width, height)
+        view = self.view_target
+        drawn = view.begin(width, height)
+        self.renderer.draw(self.camera, *drawn, multisample=view.multisample)
+        view.finish(width, height)
         self._draw_hud(now, shown)
         self.screen.draw_labels()
         if self.screenshot_requested:
