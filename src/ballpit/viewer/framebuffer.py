@@ -101,7 +101,7 @@ class WindowView:
     def multisample(self) -> bool:
         return self.target is not None and self.target.multisample
 
-    def begin(self, width: int, height: int) -> tuple[int, int]:
+    def begin(self, width: int, height: int, destination: int = 0) -> tuple[int, int]:
         """Bind where to draw for a window of ``width`` x ``height`` pixels; returns the size to draw at."""
         size = (max(round(width * self.scale), 1), max(round(height * self.scale), 1))
         if size != self.size:
@@ -116,17 +116,18 @@ class WindowView:
         elif self._texture_fbo is not None:
             GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._texture_fbo)
         else:
-            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, destination)
         return size
 
-    def finish(self, width: int, height: int) -> None:
-        """Resolve and stretch the view into the window's back buffer; leaves the window bound."""
+    def finish(self, width: int, height: int, destination: int = 0) -> None:
+        """Resolve and stretch the view into the window's back buffer (or the framebuffer
+        ``destination``); leaves that bound."""
         w, h = self.size
         if self.target is not None:  # resolve the samples: into the texture, or straight into the window
             GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.target.fbo)
-            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._texture_fbo or 0)
+            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._texture_fbo or destination)
             GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, destination)
         GL.glViewport(0, 0, width, height)
         if self._texture is not None:
             GL.glDisable(GL.GL_DEPTH_TEST)
