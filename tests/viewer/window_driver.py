@@ -423,9 +423,14 @@ def profile_page(workdir: Path) -> dict:
     press(viewer, "F2")
     pump_until(viewer, lambda: "step profile," in viewer.hud.text)
     profile = viewer.hud.text
+    quality = viewer.quality.name
+    press(viewer, "F3", frames=2)  # drawing quality, live: the other level, said in the HUD
+    switched = {"quality": viewer.quality.name, "message": shown_message(viewer), "before": quality,
+                "scale": viewer.view_target.size[0] / viewer.window.width}  # fmt: skip
     press(viewer, "F2")
     pump_until(viewer, lambda: "sim time" in viewer.hud.text)
-    return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page}
+    return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page,
+            "renderer": viewer.renderer_name, "switched": switched}  # fmt: skip
 
 
 def _bundled_viewer(name: str) -> Viewer:

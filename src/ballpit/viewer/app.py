@@ -459,7 +459,7 @@ class Viewer:
         if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + HUD_INTERVAL
             if self.hud.page == "profile":
-                drawn = f"{self.renderer_name}; quality {self.quality.describe()} (F3)"
+                drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)"]
                 self.hud.set_text(profile_lines(shown.hud, drawn))
             else:
                 extra, shot = self.interaction.hud_lines(), self.interaction.shot_speed

@@ -65,10 +65,11 @@ def profile_body(sim: Simulation) -> list[str]:
     return [f"{p.steps} steps", f"{'stage':<15}{'per step':>12}", *p.lines()]
 
 
-def profile_lines(sim: Simulation | HudFacts, renderer: str = "") -> list[str]:
-    """The HUD's profile page (F2): the step's time by stage, and the renderer drawing the window."""
+def profile_lines(sim: Simulation | HudFacts, drawn: Sequence[str] = ()) -> list[str]:
+    """The HUD's profile page (F2): the step's time by stage, then ``drawn`` (what draws the window:
+    the GL renderer and the quality)."""
     f = sim if isinstance(sim, HudFacts) else HudFacts.of(sim)
-    drawn = [f"renderer    {renderer}"] if renderer else []
+    drawn = list(drawn)
     if not f.profile:
         return [f"{f.name}: step profile", "no steps yet (X drops)", *drawn, "F2 back  H hide"]
     return [f"{f.name}: step profile, {f.profile[0]}", *f.profile[1:], *drawn, "F2 back  H hide"]

@@ -29,8 +29,8 @@ class Quality:
     def describe(self) -> str:
         msaa = f"{self.samples}x MSAA" if self.samples else "no MSAA"
         limit = self.shadow_limit
-        shadows = f"shadows of up to {limit} balls a pixel" if limit else "no shadows"
-        return f"{self.name}: {msaa}, {shadows}, view at {self.scale:.0%} resolution"
+        shadows = f"shadows {limit} balls/px" if limit else "no shadows"
+        return f"{self.name}: {msaa}, {shadows}, view {self.scale:.0%}"
 
 
 QUALITIES: dict[str, Quality] = {
