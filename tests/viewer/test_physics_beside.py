@@ -36,7 +36,7 @@ def test_esc_esc_closes_the_window_in_the_middle_of_a_10000_ball_step(xvfb, tmp_
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 def test_a_real_escape_escape_ends_the_app_mid_step_without_waiting_for_it(xvfb, tmp_path):
     """``ballpit view pile10k.toml``, X, then Esc, Esc typed through the X server while the pile lands:
-    the process exits at once, cleanly, without finishing the step in progress."""
+    the window goes at once, and the process ends cleanly without finishing the step in progress."""
     code = "import sys; from ballpit.cli import main; sys.exit(main(['view', 'pile10k']))"
     proc = subprocess.Popen(
         [sys.executable, "-c", code], env=subprocess_env(xvfb), cwd=tmp_path,
@@ -65,13 +65,16 @@ def test_a_real_escape_escape_ends_the_app_mid_step_without_waiting_for_it(xvfb,
         assert proc.poll() is None, "one Escape quit the viewer; it should ask for a second"
         pressed = time.monotonic()
         xdotool("key", "Escape")
+        closed_seconds = None
+        while closed_seconds is None and time.monotonic() - pressed < 10:
+            if not xdotool("search", "--name", "pile10k.toml"):
+                closed_seconds = time.monotonic() - pressed
         try:
             out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
             proc.kill()
             out, err = proc.communicate()
             pytest.fail(f"the viewer did not quit on Escape; stdout {out!r}; stderr {err!r}")
-        quit_seconds = time.monotonic() - pressed
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -80,4 +83,6 @@ def test_a_real_escape_escape_ends_the_app_mid_step_without_waiting_for_it(xvfb,
     assert "Traceback" not in err and "Fatal" not in err, err
     fps = float(re.search(r"(\d+\.\d) FPS$", name).group(1))
     assert fps > 2.0, name
-    assert quit_seconds < 1.5, quit_seconds  # 0.1-0.3 s measured, including xdotool and the exit
+    # 0.2-0.3 s measured from the key to the window gone, counting xdotool's own start-up (a step takes
+    # 0.1-0.5 s); the interpreter's exit after it takes another 0.5-1 s on a loaded machine
+    assert closed_seconds is not None and closed_seconds < 1.0, closed_seconds
