@@ -33,6 +33,16 @@ def test_esc_esc_closes_the_window_in_the_middle_of_a_10000_ball_step(xvfb, tmp_
     assert r["quit_seconds"] < 1.0, r  # under 0.1 s measured; a step takes 0.1-0.5 s
 
 
+def test_a_still_view_is_shown_again_rather_than_drawn_again_and_a_moving_one_is_drawn_every_frame(
+    xvfb, tmp_path
+):
+    r = run_driver(DRIVER, xvfb, "view_reuse", tmp_path, timeout=120)
+    still, flying = r["still"], r["flying"]
+    if r["quality"] == "low":  # the low view is a texture that outlives the frame
+        assert still["frames"] > 5 and still["views"] <= 6, r  # a hand-over every 0.5 s while waiting
+    assert flying["frames"] > 2 and flying["views"] == flying["frames"], r  # the camera moves
+
+
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 def test_a_real_escape_escape_ends_the_app_mid_step_without_waiting_for_it(xvfb, tmp_path):
     """``ballpit view pile10k.toml``, X, then Esc, Esc typed through the X server while the pile lands:

@@ -463,6 +463,23 @@ def pile_landing(workdir: Path) -> dict:
     return _drop_and_land(_bundled_viewer("pile.toml"), 4.0)
 
 
+def view_reuse(workdir: Path) -> dict:
+    """Waiting for X with nothing moving, then flying: frames shown against 3-D views drawn."""
+    viewer = open_viewer(world=balls_world())
+    pump_for(viewer, 0.3)
+    frames, views = viewer.frames, viewer.views_drawn
+    pump_for(viewer, 1.5)
+    still = {"frames": viewer.frames - frames, "views": viewer.views_drawn - views}
+    from pyglet.window import key
+
+    viewer.window.dispatch_event("on_key_press", key.W, 0)
+    frames, views = viewer.frames, viewer.views_drawn
+    pump_for(viewer, 0.5)
+    flying = {"frames": viewer.frames - frames, "views": viewer.views_drawn - views}
+    viewer.window.dispatch_event("on_key_release", key.W, 0)
+    return {"still": still, "flying": flying, "quality": viewer.quality.name}
+
+
 def escape_mid_step(workdir: Path) -> dict:
     """pile10k.toml landing in real time; Esc, Esc while a step runs: how long until the window closes."""
     from pyglet.window import key
@@ -499,6 +516,7 @@ SCENARIOS = {
         profile_page,
         pile_landing,
         escape_mid_step,
+        view_reuse,
     )
 }
 

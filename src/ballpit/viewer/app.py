@@ -100,6 +100,9 @@ class Viewer:
         self._interaction_seconds: deque[float] = deque()
         self._interaction_input: tuple = ()
         self._interaction_queued = False
+        self._drawn_key: tuple | None = None
+        self._drawn_shown: Shown | None = None  # keeps the object whose id is in the key alive
+        self.views_drawn = 0  # how many frames drew the 3-D view (others showed the last one again)
         self.held: set[str] = set()
         self.mouse_captured = False
         self._quit_armed_until = 0.0  # a second Esc before this time quits
@@ -408,14 +411,18 @@ class Viewer:
         shown = self.physics.shown
 
         self.window.switch_to()
-        selected = self.interaction.selected_plane
-        self.renderer.selected_plane = -1 if selected is None else selected
-        self.feeder.upload(shown, self.flags, self.camera.position, self.interaction.lines())
-        self.screen.upload(self.renderer)
         width, height = self.window.get_framebuffer_size()
         view = self.view_target
         drawn = view.begin(width, height)
-        self.renderer.draw(self.camera, *drawn, multisample=view.multisample)
+        key = self._view_key(shown, width, height)
+        if not (view.keeps_image and key is not None and key == self._drawn_key):
+            selected = self.interaction.selected_plane
+            self.renderer.selected_plane = -1 if selected is None else selected
+            self.feeder.upload(shown, self.flags, self.camera.position, self.interaction.lines())
+            self.screen.upload(self.renderer)
+            self.renderer.draw(self.camera, *drawn, multisample=view.multisample)
+            self._drawn_key, self._drawn_shown = key, shown
+            self.views_drawn += 1
         view.finish(width, height)
         self._draw_hud(now, shown)
         self.screen.draw_labels()
@@ -423,6 +430,17 @@ class Viewer:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
         self._count_frame(now, shown)
+
+    def _view_key(self, shown: Shown, width: int, height: int) -> tuple | None:
+        """Everything the 3-D view (and the bar and plot drawn with it) depends on: while it stays the
+        same (paused, waiting for X, nothing moving) the view drawn last is shown again, not redrawn.
+        None while a ball is held (its throw arrow follows the pointer)."""
+        if self.interaction.held_ball is not None:
+            return None
+        c = self.camera
+        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, width, height,
+                self.flags.contacts, self.flags.velocities, self.flags.trails, self.screen.show_plot,
+                self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
     def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:
         """A held ball follows the pointer and a selected plane the held keys: the physics side does it

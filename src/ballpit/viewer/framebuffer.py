@@ -101,6 +101,12 @@ class WindowView:
     def multisample(self) -> bool:
         return self.target is not None and self.target.multisample
 
+    @property
+    def keeps_image(self) -> bool:
+        """Whether the last view drawn survives the frame (it is not the window's own back buffer), so
+        an unchanged view can be shown again by ``finish`` alone, without drawing it."""
+        return self.target is not None or self._texture is not None
+
     def begin(self, width: int, height: int, destination: int = 0) -> tuple[int, int]:
         """Bind where to draw for a window of ``width`` x ``height`` pixels; returns the size to draw at."""
         size = (max(round(width * self.scale), 1), max(round(height * self.scale), 1))

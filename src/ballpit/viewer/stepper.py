@@ -38,6 +38,7 @@ from .handover import HudFacts, Needs, Shown, capture
 from .simulation import Phase, Simulation
 
 HUD_INTERVAL = 0.1  # seconds between readings of the HUD's facts (energy, drifts, profile)
+IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no command came
 IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
@@ -133,7 +134,7 @@ class PhysicsThread:
 
     # ------------------------------------------------------------------ the physics side
     def _run(self) -> None:
-        last = time.perf_counter()
+        last = published = time.perf_counter()
         while not self._stopped:
             if not self._free:
                 self._wake.wait(IDLE_WAIT)
@@ -144,13 +145,15 @@ class PhysicsThread:
                 if not self._free or self._stopped:
                     continue
                 try:
-                    self._apply_commands()
+                    commands = self._apply_commands()
                     now = time.perf_counter()
                     if self._restart_clock:
                         self._restart_clock, last = False, now
-                    self.sim.advance(now - last)
+                    steps = self.sim.advance(now - last)
                     last = now
-                    self._publish(force_hud=False)
+                    if steps or commands or now - published >= IDLE_HANDOVER:  # else the same as before:
+                        self._publish(force_hud=False)  # the window may keep the view it drew
+                        published = now
                 except Exception as exc:  # never let the thread die silently: say why in the HUD
                     self.crash = f"physics thread stopped: {type(exc).__name__}: {exc}"
                     self.sim.error = self.crash
@@ -164,8 +167,11 @@ class PhysicsThread:
                 self._wake.wait(min(wait, IDLE_WAIT))
                 self._wake.clear()
 
-    def _apply_commands(self) -> None:
+    def _apply_commands(self) -> int:
+        """Run the commands sent so far; returns how many."""
+        count = 0
         while self._commands:
+            count += 1
             command, then = self._commands.popleft()
             try:
                 result = command(self.sim)
@@ -175,6 +181,7 @@ class PhysicsThread:
                 print(f"ballpit: {self.sim.error}", file=sys.stderr, flush=True)
             if then is not None:
                 self._results.append((then, result))
+        return count
 
     def _capture(self, force_hud: bool) -> Shown:
         now = time.perf_counter()
