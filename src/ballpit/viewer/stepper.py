@@ -18,10 +18,15 @@ Two ways to run:
 - lockstep (``advance(dt)``): the caller's thread takes the lock and advances exactly ``dt`` of real
   time, applying the commands first. Tests and scripted runs use it for exact, repeatable frames.
 
-Measured on a 2-core machine with a CPU rasteriser (see benchmarks/physics_beside_drawing.py): a thread
-beside the drawing beat a process. NumPy and the GL driver release the GIL in their large operations
-and llvmpipe rasterises on threads of its own, while a process pays for copying the state across and
-for a second interpreter on the same two cores.
+A thread rather than a process, by the figures of benchmarks/physics_beside_drawing.py on a 2-core
+machine with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s
+with the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17
+and 17); with slopes.toml stepping flat out, 15 and 19 frames/s against 16 and 16 (194 and 225 steps/s
+against 177 and 182). A process buys nothing here: the two cores are shared with llvmpipe's own
+threads either way, and the GL driver and NumPy's large operations release the GIL. A thread keeps
+every World-touching feature (history, ghosts, recording, picking, saving) in one address space with
+plain function calls as commands. The GIL switch interval is lowered while it runs so the window,
+coming back from a GL call, waits at most about a millisecond for the physics to let go.
 """
 
 from __future__ import annotations
