@@ -109,6 +109,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--record", type=Path, metavar="FILE", help="when the window closes, write every step "
                    "it showed to FILE (.npz or .csv, simulate's trajectory columns)")  # fmt: skip
+    p.add_argument("--quality", choices=("auto", "low", "high"), default="auto",
+                   help="drawing quality: low (no MSAA, cheap shadows, the view at half resolution) "
+                   "or high; auto (default) is low on a software renderer such as llvmpipe; F3 "
+                   "switches live")  # fmt: skip
     p.set_defaults(handler=_view)
 
     p = sub.add_parser("check", help="validate a scene file")
@@ -385,7 +389,7 @@ def _view(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_FAILED
-    return int(run(path, trajectory=trajectory, record=args.record) or EXIT_OK)
+    return int(run(path, trajectory=trajectory, record=args.record, quality=args.quality) or EXIT_OK)
 
 
 def _render(args: argparse.Namespace) -> int:

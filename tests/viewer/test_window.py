@@ -257,3 +257,16 @@ def test_f2_shows_the_time_of_each_stage_of_the_step_and_f2_again_goes_back(xvfb
     steps = int(re.search(r"step profile, (\d+) steps", text).group(1))
     assert steps > 0 and re.search(r"intervals/step \d+\.\d+", text)
     assert result["page"] == "stats" and "sim time" in result["back"]
+
+
+def test_f2_names_the_renderer_and_its_quality_and_f3_switches_the_quality_live(xvfb, tmp_path):
+    result = run_scenario(xvfb, "profile_page", tmp_path)
+    lines = result["profile"].splitlines()
+    assert f"renderer    {result['renderer']}" in lines
+    switched = result["switched"]
+    assert any(line.startswith(f"quality     {switched['before']}: ") for line in lines), lines
+    if "llvmpipe" in result["renderer"]:  # Xvfb: Mesa's CPU rasteriser, so it starts low
+        assert switched["before"] == "low"
+    assert switched["quality"] != switched["before"]
+    assert switched["message"].startswith(f"quality {switched['quality']}: ")
+    assert switched["scale"] == (1.0 if switched["quality"] == "high" else 0.5)

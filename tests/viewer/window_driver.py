@@ -43,7 +43,7 @@ OPENED: list[Viewer] = []
 def open_viewer(size: tuple[int, int] = (320, 180), **kwargs: object) -> Viewer:
     """A viewer window without multisampling (no scenario looks at anti-aliased edges; the renderer
     tests do), at ``size``."""
-    viewer = Viewer(size=size, samples=0, **kwargs)
+    viewer = Viewer(size=size, **kwargs)
     viewer.sim.step_budget = math.inf  # exact simulated time per frame even on a loaded machine
     OPENED.append(viewer)
     return viewer
@@ -242,6 +242,7 @@ def broken_reload(workdir: Path) -> dict:
 
     touch_later(scene, GOOD_SCENE + "\n[[sphere]]\nposition = [1, 3, 0]\nradius = 0.2\n")
     pump_until(viewer, lambda: viewer.sim.ball_count == 2)
+    pump(viewer, 2)  # the physics thread reloaded it: the window hears back on its next frames
     out["fixed_error"] = viewer.hud.error
     out["fixed_balls"] = sim.ball_count
     out["fixed_phase"] = sim.phase.name
@@ -425,9 +426,81 @@ def profile_page(workdir: Path) -> dict:
     press(viewer, "F2")
     pump_until(viewer, lambda: "step profile," in viewer.hud.text)
     profile = viewer.hud.text
+    quality = viewer.quality.name
+    press(viewer, "F3", frames=2)  # drawing quality, live: the other level, said in the HUD
+    switched = {"quality": viewer.quality.name, "message": shown_message(viewer), "before": quality,
+                "scale": viewer.view_target.size[0] / viewer.window.width}  # fmt: skip
     press(viewer, "F2")
     pump_until(viewer, lambda: "sim time" in viewer.hud.text)
-    return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page}
+    return {"profile": profile, "back": viewer.hud.text, "page": viewer.hud.page,
+            "renderer": viewer.renderer_name, "switched": switched}  # fmt: skip
+
+
+def _bundled_viewer(name: str) -> Viewer:
+    """The bundled scene ``name`` in a default-sized window, its physics running free as in the app."""
+    from ballpit.scene import default_scene_path
+
+    viewer = Viewer(size=(1280, 720), scene_path=default_scene_path().with_name(name))
+    OPENED.append(viewer)
+    return viewer
+
+
+def _drop_and_land(viewer: Viewer, seconds: float) -> dict:
+    """X, then wait for the first step, then count frames drawn and steps taken for ``seconds``."""
+    from pyglet.window import key
+
+    pump_for(viewer, 0.5)
+    viewer.window.dispatch_event("on_key_press", key.X, 0)
+    pump_until(viewer, lambda: viewer.sim.steps_total > 0, timeout=30)
+    pump_for(viewer, 1.0)  # into the landing: the balls reach the floor
+    frames, steps, started = viewer.frames, viewer.sim.steps_total, time.perf_counter()
+    pump_for(viewer, seconds)
+    wall = time.perf_counter() - started
+    steps_per_second = (viewer.sim.steps_total - steps) / wall
+    return {"fps": (viewer.frames - frames) / wall, "steps_per_second": steps_per_second,
+            "caption": viewer.window.caption, "hud": viewer.hud.text}  # fmt: skip
+
+
+def pile_landing(workdir: Path) -> dict:
+    """pile.toml (1,200 balls) landing in real time: frames drawn against physics steps taken."""
+    return _drop_and_land(_bundled_viewer("pile.toml"), 4.0)
+
+
+def view_reuse(workdir: Path) -> dict:
+    """Waiting for X with nothing moving, then flying: frames shown against 3-D views drawn."""
+    viewer = open_viewer(world=balls_world())
+    pump_for(viewer, 0.3)
+    frames, views = viewer.frames, viewer.views_drawn
+    pump_for(viewer, 1.5)
+    still = {"frames": viewer.frames - frames, "views": viewer.views_drawn - views}
+    from pyglet.window import key
+
+    viewer.window.dispatch_event("on_key_press", key.W, 0)
+    frames, views = viewer.frames, viewer.views_drawn
+    pump_for(viewer, 0.5)
+    flying = {"frames": viewer.frames - frames, "views": viewer.views_drawn - views}
+    viewer.window.dispatch_event("on_key_release", key.W, 0)
+    return {"still": still, "flying": flying, "quality": viewer.quality.name}
+
+
+def escape_mid_step(workdir: Path) -> dict:
+    """pile10k.toml landing in real time; Esc, Esc while a step runs: how long until the window closes."""
+    from pyglet.window import key
+
+    viewer = _bundled_viewer("pile10k.toml")
+    out = _drop_and_land(viewer, 1.0)
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    pump(viewer, 2, dt=None)
+    pump_until(viewer, lambda: viewer.physics.lock.locked(), timeout=10)  # a step is in progress
+    out["stepping_at_escape"] = viewer.physics.lock.locked()
+    pressed = time.perf_counter()
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    while not viewer.closed and time.perf_counter() - pressed < 10:
+        viewer.pump()
+    viewer.pump()  # outside pyglet's loop the window closes on the next pump
+    out["quit_seconds"] = time.perf_counter() - pressed
+    out["closed"] = viewer.closed
+    return out
 
 
 SCENARIOS = {
@@ -444,6 +517,9 @@ SCENARIOS = {
         help_beside_hud,
         double_escape,
         profile_page,
+        pile_landing,
+        escape_mid_step,
+        view_reuse,
     )
 }
 

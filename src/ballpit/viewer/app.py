@@ -2,17 +2,25 @@
 
 ``run`` is what ``ballpit`` / ``ballpit view`` call. ``Viewer`` is the window itself; tests drive it
 frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window.
+
+The physics runs beside the window on a thread of its own (stepper.py): the window draws the latest
+state it handed over and sends it what the keys and the mouse ask as commands, applied between steps.
+In pyglet's loop (``frame()`` without ``dt``) the physics runs free on the wall clock; a frame given a
+``dt`` advances it by exactly that much first (lockstep), which is what tests and scripts use.
 """
 
 from __future__ import annotations
 
+import copy
 import sys
 import time
+from collections import deque
 from datetime import datetime
 from pathlib import Path
 
 from . import backend, controls
 from .controls import Action
+from .handover import Needs, Shown
 from .simulation import Simulation
 
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
@@ -40,8 +48,8 @@ def title(scene_name: str, fps: float) -> str:
 
 class Viewer:
     """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
-    file ``scene_path`` (the bundled demo by default). ``samples``: the multisampling asked for (4×
-    MSAA; 0 for none, as the window tests use to draw 4× less on a software rasteriser)."""
+    file ``scene_path`` (the bundled demo by default). ``quality``: ``auto``, ``low`` or ``high``
+    (quality.py; auto is low on a software rasteriser such as llvmpipe, as in the window tests)."""
 
     def __init__(
         self,
@@ -51,7 +59,7 @@ class Viewer:
         visible: bool = True,
         trajectory: object = None,
         record: Path | None = None,
-        samples: int = 4,
+        quality: str = "auto",
     ) -> None:
         backend.use_window()
         import pyglet
@@ -62,6 +70,7 @@ class Viewer:
         from .interaction import Interaction
         from .renderer import Renderer
         from .screen import ScreenOverlay
+        from .stepper import PhysicsThread
 
         if world is None:
             from ballpit.scene import read_scene
@@ -79,12 +88,22 @@ class Viewer:
             self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
-        self.window = self._open_window(size, visible, samples)
+        self.window = self._open_window(size, visible)
         self.renderer = Renderer()
+        self.renderer_name = _gl_renderer()
+        self.view_target = None  # the framebuffer the 3-D view is drawn into (quality.py)
+        self.set_quality(quality)
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
-        self.screen = ScreenOverlay(self.window, self.sim)
+        self.physics = PhysicsThread(self.sim, needs=self._needs)
+        self.screen = ScreenOverlay(self.window, self.physics)
+        self._interaction_seconds: deque[float] = deque()
+        self._interaction_input: tuple = ()
+        self._interaction_queued = False
+        self._drawn_key: tuple | None = None
+        self._drawn_shown: Shown | None = None  # keeps the object whose id is in the key alive
+        self.views_drawn = 0  # how many frames drew the 3-D view (others showed the last one again)
         self.held: set[str] = set()
         self.mouse_captured = False
         self._quit_armed_until = 0.0  # a second Esc before this time quits
@@ -107,48 +126,72 @@ class Viewer:
         self._pyglet = pyglet
 
     # ------------------------------------------------------------------ window
-    def _open_window(self, size: tuple[int, int], visible: bool, samples: int):
+    def _open_window(self, size: tuple[int, int], visible: bool):
+        """A single-sampled window: the 3-D view is drawn into a framebuffer of its own (multisampled or
+        smaller, as the quality says) and copied in, and the HUD is drawn over it at full size."""
         import pyglet
         from pyglet import gl
 
-        base = dict(
+        config = gl.Config(
             major_version=3, minor_version=3, forward_compatible=True, double_buffer=True, depth_size=24
         )
-        attempts = [dict(base, sample_buffers=1, samples=samples), base] if samples else [base]
-        for i, attrs in enumerate(attempts):
-            try:
-                window = pyglet.window.Window(
-                    width=size[0], height=size[1], caption="ballpit", resizable=True, vsync=True,
-                    visible=visible, config=gl.Config(**attrs),
-                )  # fmt: skip
-            except pyglet.window.NoSuchConfigException:
-                if i == len(attempts) - 1:
-                    raise
-                continue
-            self.multisample = bool(attrs.get("samples"))
-            return window
-        raise AssertionError("unreachable")
+        return pyglet.window.Window(
+            width=size[0], height=size[1], caption="ballpit", resizable=True, vsync=True,
+            visible=visible, config=config,
+        )  # fmt: skip
+
+    def set_quality(self, option: str) -> None:
+        """``auto``, ``low`` or ``high`` (quality.py): MSAA, shadows and the view's resolution."""
+        from .framebuffer import WindowView
+        from .quality import choose
+
+        self.quality = q = choose(option, self.renderer_name)
+        self.renderer.shadows = q.shadow_limit > 0
+        self.renderer.shadow_limit = max(q.shadow_limit, 1)
+        if self.view_target is not None:
+            self.window.switch_to()
+            self.view_target.delete()
+        self.view_target = WindowView(q.samples, q.scale)
+
+    @property
+    def multisample(self) -> bool:
+        return self.quality.samples > 0
+
+    def _needs(self) -> Needs:
+        """What the physics should copy for the window (asked at every hand-over)."""
+        f, screen = self.flags, getattr(self, "screen", None)
+        return Needs(f.contacts, f.velocities, f.trails, energy=screen is not None and screen.show_plot)
+
+    @property
+    def shown(self) -> Shown:
+        """The latest state the physics handed over."""
+        return self.physics.shown
+
+    def command(self, fn, then=None) -> None:
+        """Ask the physics side to run ``fn(sim)`` between steps (``then(result)`` back here after)."""
+        self.physics.submit(fn, then)
 
     # ------------------------------------------------------------------ actions
     def perform(self, action: Action) -> None:
-        """Do what a key asks for."""
-        sim = self.sim
+        """Do what a key asks for. What changes the World goes to the physics side as a command."""
+        do = self.command
         if action is Action.START:
-            sim.start()
+            do(lambda sim: sim.start())
         elif action is Action.PAUSE:
-            sim.toggle_pause()
+            do(lambda sim: sim.toggle_pause())
         elif action is Action.STEP:
-            sim.step_once()
+            do(lambda sim: sim.step_once())
         elif action is Action.RESET:
-            sim.reset()
+            do(lambda sim: sim.reset())
         elif action is Action.RELOAD:
             self.reload()
         elif action in controls.INTEGRATOR_ACTIONS:
-            sim.set_integrator(controls.INTEGRATOR_ACTIONS[action])
+            name = controls.INTEGRATOR_ACTIONS[action]
+            do(lambda sim: sim.set_integrator(name))
         elif action is Action.FASTER:
-            sim.faster()
+            do(lambda sim: sim.faster())
         elif action is Action.SLOWER:
-            sim.slower()
+            do(lambda sim: sim.slower())
         elif action is Action.CAPTURE_MOUSE:
             self.capture_mouse(not self.mouse_captured)
         elif action is Action.ESCAPE:
@@ -168,25 +211,34 @@ class Viewer:
             self.hud.show_help = not self.hud.show_help
         elif action is Action.SCREENSHOT:
             self.screenshot_requested = True
+        elif action is Action.QUALITY:
+            from .quality import other
+
+            self.set_quality(other(self.quality).name)
+            self.hud.flash(f"quality {self.quality.describe()}", time.perf_counter())
         elif action in controls.TIME_ACTIONS:
-            controls.TIME_ACTIONS[action](sim)
+            do(controls.TIME_ACTIONS[action])
         elif action is Action.ENERGY_PLOT:
             self.screen.show_plot = not self.screen.show_plot
         elif action is Action.SHOOT:
-            self.interaction.shoot(self.camera)
+            camera = copy.deepcopy(self.camera)
+            do(lambda sim: self.interaction.shoot(camera))
         elif action is Action.SHOT_SPEED:
-            sim.message = f"shot speed {self.interaction.next_shot_speed():g} m/s"
+            self.hud.flash(f"shot speed {self.interaction.next_shot_speed():g} m/s", time.perf_counter())
         elif action is Action.HOME:
-            self.camera.look_from(sim.appearance.camera_position, sim.appearance.camera_look_at)
+            look = self.shown.appearance
+            self.camera.look_from(look.camera_position, look.camera_look_at)
         elif action is Action.SAVE:
             self.save_scene()
         self._hud_at = 0.0  # refresh the HUD on the next frame
+        self.physics.refresh_hud()
 
     def escape(self) -> None:
         """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
         until then the HUD asks for it."""
         now = time.perf_counter()
-        if not self.mouse_captured and self.interaction.deselect():
+        if not self.mouse_captured and self.interaction.selected_plane is not None:
+            self.command(lambda sim: self.interaction.deselect())
             self.hud.flash("plane deselected", now)
             return
         outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
@@ -198,26 +250,35 @@ class Viewer:
         self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
         self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 
-    def reload(self) -> bool:
-        ok = self.sim.reload()
-        self.hud.set_error(self.sim.error)
-        return ok
+    def reload(self) -> None:
+        """Ctrl+R / F5: the physics side loads the file again between steps; a failed reload keeps the
+        last good scene and the HUD shows the error."""
+        self.command(lambda sim: (sim.reload(), sim.error)[1], self.hud.set_error)
 
-    def save_scene(self) -> Path | None:
+    def save_scene(self) -> None:
         """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
-        from .save import save_scene
+        camera = copy.deepcopy(self.camera)
 
-        try:
-            self.last_save = save_scene(self.sim, self.camera, self.interaction.own_motion())
-        except OSError as exc:
-            self.hud.flash(f"save failed: {exc}", time.perf_counter())
-            return None
+        def save(sim: Simulation) -> Path | OSError:
+            from .save import save_scene
+
+            try:
+                return save_scene(sim, camera, self.interaction.own_motion())
+            except OSError as exc:
+                return exc
+
+        self.command(save, self._saved)
+
+    def _saved(self, result: Path | OSError) -> None:
+        if isinstance(result, Exception):
+            self.hud.flash(f"save failed: {result}", time.perf_counter())
+            return
+        self.last_save = result
         shown = self.last_save
         if shown.is_relative_to(Path.cwd()):
             shown = shown.relative_to(Path.cwd())
         print(f"scene saved to {self.last_save}", flush=True)
         self.hud.flash(f"scene saved to {shown}", time.perf_counter())
-        return self.last_save
 
     def capture_mouse(self, captured: bool) -> None:
         self.mouse_captured = captured
@@ -227,6 +288,7 @@ class Viewer:
         """Close the window. Outside pyglet's loop (``pump``) the close waits until the events being
         dispatched are done, since pyglet's xlib dispatch cannot continue on a closed window."""
         self.closed = True
+        self.physics.stop()  # at once: a step in progress is not waited for
         if self._pyglet.app.event_loop.is_running:
             self._close_window()
 
@@ -237,10 +299,13 @@ class Viewer:
             self.window.close()
 
     def finish_record(self) -> None:
-        """Write the ``--record`` file (once), when the window closes or the run is interrupted."""
+        """Write the ``--record`` file (once), when the window closes or the run is interrupted: the
+        steps finished by then (a step still in progress on the physics thread is left out)."""
         if self.recorder is not None and not self.recorder.finished:
-            steps, path = self.recorder.steps, self.recorder.finish()
-            print(f"recorded {steps} steps ({self.sim.ball_count} balls) to {path}", flush=True)
+            finished = self.recorder.finish()
+            if finished is not None:
+                path, steps, balls = finished
+                print(f"recorded {steps} steps ({balls} balls) to {path}", flush=True)
 
     # ------------------------------------------------------------------ pyglet events
     def on_key_press(self, symbol: int, modifiers: int) -> bool:
@@ -281,14 +346,19 @@ class Viewer:
 
         if button == mouse.LEFT and not self.mouse_captured:
             ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
-            self.sim.message = self.interaction.press(ray, x, y, self.camera.forward) or self.sim.message
+            facing = self.camera.forward
+
+            def press(sim: Simulation) -> None:
+                sim.message = self.interaction.press(ray, x, y, facing) or sim.message
+
+            self.command(press)
 
     def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
         self.screen.release()
         if button == mouse.LEFT:
-            self.interaction.release()
+            self.command(lambda sim: self.interaction.release())
 
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         from pyglet.window import mouse
@@ -312,6 +382,7 @@ class Viewer:
 
     def on_close(self) -> None:
         self.closed = True
+        self.physics.stop()
         self.finish_record()
 
     def on_draw(self) -> None:
@@ -319,70 +390,113 @@ class Viewer:
 
     # ------------------------------------------------------------------ the frame
     def frame(self, dt: float | None = None) -> None:
-        """Advance the camera and physics by real time (or by ``dt``) and draw one frame."""
+        """Fly the camera by real time (or by ``dt``), let the physics run (free, or lockstep by ``dt``)
+        and draw the latest state it handed over."""
         now = time.perf_counter()
         elapsed = now - self._last_frame if dt is None else dt
         self._last_frame = now
         self.camera.fly(
             controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
         )
-
-        size = (self.window.width, self.window.height)
-        self.interaction.update(self.camera, size, self.held, elapsed)
-        started = time.perf_counter()
-        self.sim.advance(elapsed)
-        self.physics_seconds = time.perf_counter() - started
+        self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
             self._watch_at = now + WATCH_INTERVAL
-            if self.sim.file_changed():
-                self.reload()
+            self.command(lambda sim: (sim.file_changed() and sim.reload(), sim.error)[1], self.hud.set_error)
+        started = time.perf_counter()
+        if dt is None:
+            self.physics.run_free()
+        else:
+            self.physics.advance(elapsed)
+        self.physics_seconds = time.perf_counter() - started  # lockstep only: free, it is 0
+        self.physics.deliver()
+        shown = self.physics.shown
 
         self.window.switch_to()
-        selected = self.interaction.selected_plane
-        self.renderer.selected_plane = -1 if selected is None else selected
-        self.feeder.upload(self.sim, self.flags, self.camera.position, self.interaction.lines())
-        self.screen.upload(self.renderer)
         width, height = self.window.get_framebuffer_size()
-        self.renderer.draw(self.camera, width, height, multisample=self.multisample)
-        self._draw_hud(now)
+        view = self.view_target
+        drawn = view.begin(width, height)
+        key = self._view_key(shown, width, height)
+        if not (view.keeps_image and key is not None and key == self._drawn_key):
+            selected = self.interaction.selected_plane
+            self.renderer.selected_plane = -1 if selected is None else selected
+            self.feeder.upload(shown, self.flags, self.camera.position, self.interaction.lines())
+            self.screen.upload(self.renderer)
+            self.renderer.draw(self.camera, *drawn, multisample=view.multisample)
+            self._drawn_key, self._drawn_shown = key, shown
+            self.views_drawn += 1
+        view.finish(width, height)
+        self._draw_hud(now, shown)
         self.screen.draw_labels()
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
-        self._count_frame(now)
+        self._count_frame(now, shown)
+
+    def _view_key(self, shown: Shown, width: int, height: int) -> tuple | None:
+        """Everything the 3-D view (and the bar and plot drawn with it) depends on: while it stays the
+        same (paused, waiting for X, nothing moving) the view drawn last is shown again, not redrawn.
+        None while a ball is held (its throw arrow follows the pointer)."""
+        if self.interaction.held_ball is not None:
+            return None
+        c = self.camera
+        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, width, height,
+                self.flags.contacts, self.flags.velocities, self.flags.trails, self.screen.show_plot,
+                self.interaction.selected_plane, id(self.view_target))  # fmt: skip
+
+    def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:
+        """A held ball follows the pointer and a selected plane the held keys: the physics side does it
+        between steps, with this frame's camera and keys (frames that pass meanwhile add their time)."""
+        self._interaction_seconds.append(seconds)
+        it = self.interaction
+        if it.held_ball is None and it.selected_plane is None:
+            self._interaction_seconds.clear()
+            return
+        self._interaction_input = (copy.deepcopy(self.camera), size, frozenset(self.held))
+        if not self._interaction_queued:
+            self._interaction_queued = True
+            self.command(self._update_interaction)
+
+    def _update_interaction(self, sim: Simulation) -> None:
+        self._interaction_queued = False
+        camera, size, held = self._interaction_input
+        seconds = 0.0
+        while self._interaction_seconds:
+            seconds += self._interaction_seconds.popleft()
+        self.interaction.update(camera, size, held, seconds)
 
     def _overlay_names(self) -> str:
         f = self.flags
         return " ".join(name for name, on in (("contacts", f.contacts), ("velocities", f.velocities),
                                               ("trails", f.trails)) if on)  # fmt: skip
 
-    def _draw_hud(self, now: float) -> None:
+    def _draw_hud(self, now: float, shown: Shown) -> None:
         from .hud import hud_lines, profile_lines
 
         if self.hud.bottom != self.screen.bottom_clearance():
             self.hud.bottom = self.screen.bottom_clearance()
             self.hud.layout()
-        if now >= self._hud_at:
+        if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + HUD_INTERVAL
             if self.hud.page == "profile":
-                self.hud.set_text(profile_lines(self.sim))
+                drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)"]
+                self.hud.set_text(profile_lines(shown.hud, drawn))
             else:
                 extra, shot = self.interaction.hud_lines(), self.interaction.shot_speed
-                self.hud.set_text(hud_lines(self.sim, self.camera.speed, self._overlay_names(), extra, shot))
-            self.hud.set_error(self.sim.error)
-        if self.sim.message != self._shown_message:
-            self._shown_message = self.sim.message
-            if self.sim.message:
-                self.hud.flash(self.sim.message, now)
+                self.hud.set_text(hud_lines(shown.hud, self.camera.speed, self._overlay_names(), extra, shot))
+            self.hud.set_error(shown.error)
+        if shown.message != self._shown_message:
+            self._shown_message = shown.message
+            if shown.message:
+                self.hud.flash(shown.message, now)
         self.hud.draw(now)
 
-    def _count_frame(self, now: float) -> None:
+    def _count_frame(self, now: float, shown: Shown) -> None:
         self.frames += 1
         self._fps_frames += 1
         if now - self._fps_since >= TITLE_INTERVAL:
             self.fps = self._fps_frames / (now - self._fps_since)
             self._fps_since, self._fps_frames = now, 0
-            self.window.set_caption(title(self.sim.appearance.name, self.fps))
+            self.window.set_caption(title(shown.appearance.name, self.fps))
 
     def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
         """Save the back buffer (what this frame drew, HUD included) as a PNG in ``directory``
@@ -413,6 +527,10 @@ class Viewer:
         self.hud.flash(f"screenshot saved to {shown}", time.perf_counter())
         return self.last_screenshot
 
+    def sync(self) -> None:
+        """Apply the commands sent so far now (waiting for a step in progress): for tests and scripts."""
+        self.physics.sync()
+
     def pump(self, dt: float | None = None) -> None:
         """One turn of the event loop by hand: deliver queued window events, draw a frame, flip.
         (pyglet queues events dispatched before its loop runs; this is what tests drive.)"""
@@ -432,7 +550,20 @@ class Viewer:
         self._pyglet.app.run(FRAME_INTERVAL)
 
 
-def run(scene_path: Path | None = None, trajectory: object = None, record: Path | None = None) -> int:
+def _gl_renderer() -> str:
+    """GL_RENDERER of the current context, e.g. "llvmpipe (LLVM 15.0.7, 256 bits)"."""
+    from OpenGL import GL
+
+    name = GL.glGetString(GL.GL_RENDERER)
+    return name.decode(errors="replace") if name else "unknown"
+
+
+def run(
+    scene_path: Path | None = None,
+    trajectory: object = None,
+    record: Path | None = None,
+    quality: str = "auto",
+) -> int:
     """Open the viewer on a scene file (the bundled slopes demo by default); returns the exit status.
     With ``record``, the timeline it showed is written there when the window closes (or on Ctrl+C).
 
@@ -444,7 +575,7 @@ def run(scene_path: Path | None = None, trajectory: object = None, record: Path 
         print(backend.no_display_message(problem), file=sys.stderr)
         return 1
     try:
-        viewer = Viewer(scene_path=scene_path, trajectory=trajectory, record=record)
+        viewer = Viewer(scene_path=scene_path, trajectory=trajectory, record=record, quality=quality)
     except Exception as exc:
         if _is_no_display(exc):
             print(backend.no_display_message(str(exc) or "cannot connect"), file=sys.stderr)

@@ -39,6 +39,7 @@ class Action(Enum):
     PROFILE = "HUD page: where the step's time goes"
     HELP = "show / hide this help"
     SCREENSHOT = "save a screenshot PNG"
+    QUALITY = "drawing quality: low / high"
     STEP_BACK = "one step back through the history while paused"
     JUMP_BACK = "a second back through the history while paused"
     JUMP_FORWARD = "a second forward through the history while paused"
@@ -65,6 +66,7 @@ KEY_ACTIONS: dict[str, Action] = {
     "H": Action.HUD,
     "F1": Action.HELP,
     "F2": Action.PROFILE,
+    "F3": Action.QUALITY,
     "F12": Action.SCREENSHOT,
     "LEFT": Action.STEP_BACK,
     "G": Action.GHOSTS,
@@ -140,7 +142,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("right drag or Tab", "look around (Tab captures the mouse)"),
     ("Esc", "release the mouse, drop a plane; twice quits"),
     ("C / V / T, P", "contacts, velocities, trails; energy plot"),
-    ("H / F1 / F2", "HUD / this help / HUD page: time per stage"),
+    ("H / F1 / F2 / F3", "HUD / this help / time per stage / quality"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),
     ("B / Shift+B", "shoot a ball along the view / its speed"),

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import overlays
+from .handover import Needs, Shown, capture
 from .renderer import Renderer
 from .simulation import Simulation
 
@@ -28,46 +29,46 @@ class FrameFeeder:
     def __init__(self, renderer: Renderer) -> None:
         self.renderer = renderer
         self._generation: int | None = None
-        self._sim: Simulation | None = None
         self._plane_pose = np.zeros((0, 7))
         self.plane_uploads = 0  # how many times the plane quads were rebuilt (tests read it)
         self.upload_seconds = 0.0
 
     def upload(
         self,
-        sim: Simulation,
+        sim: Simulation | Shown,
         flags: OverlayFlags | None = None,
         eye: np.ndarray | None = None,
         extra_lines: np.ndarray | None = None,
     ) -> None:
         """Upload this frame's balls (sorted nearest first when ``eye`` is given), lines (``extra_lines``
-        are drawn on top, like the overlays) and the planes when the scene changed or they moved."""
+        are drawn on top, like the overlays) and the planes when the scene changed or they moved.
+        ``sim``: what the physics handed over, or a Simulation to copy it from now."""
         started = time.perf_counter()
         flags = flags or OverlayFlags()
-        look = sim.appearance
-        world = sim.world
-        centers, plane_orientations = sim.render_planes()
-        pose = np.hstack([centers, plane_orientations])
-        changed = sim is not self._sim or sim.generation != self._generation
+        if isinstance(sim, Shown):
+            shown = sim
+        else:
+            needs = Needs(flags.contacts, flags.velocities, flags.trails, energy=False, hud=False)
+            shown = capture(sim, needs)
+        pose = np.hstack([shown.plane_centers, shown.plane_orientations])
+        changed = shown.generation != self._generation
         if changed or pose.shape != self._plane_pose.shape or not np.array_equal(pose, self._plane_pose):
-            planes = world.planes
-            self.renderer.set_planes(centers, plane_orientations, planes.half_sizes, look.plane_colors)
-            self._sim, self._generation, self._plane_pose = sim, sim.generation, pose
+            self.renderer.set_planes(shown.plane_centers, shown.plane_orientations, shown.plane_half_sizes,
+                                     shown.appearance.plane_colors)  # fmt: skip
+            self._generation, self._plane_pose = shown.generation, pose
             self.plane_uploads += 1
-        positions, orientations = sim.render_state()
-        spheres = world.spheres
-        colors = look.sphere_colors[: len(positions)]  # a replay or the history may hold fewer balls now
-        self.renderer.upload_balls(positions, orientations, spheres.radii, colors, eye)
-        self._upload_ghosts(sim)
+        positions = shown.positions
+        self.renderer.upload_balls(positions, shown.orientations, shown.radii, shown.sphere_colors, eye)
+        self._upload_ghosts(shown)
 
         world_lines, overlay_lines = overlays.empty(), overlays.empty()
-        if flags.trails and sim.trails.filled:
-            world_lines = overlays.trail_lines(sim.trails.ordered(), colors, positions)
+        if flags.trails and shown.trails is not None and shown.trails.shape[1] == len(positions):
+            world_lines = overlays.trail_lines(shown.trails, shown.sphere_colors, positions)
         parts = []
-        if flags.contacts and sim.contacts is not None and len(sim.contacts):
-            parts.append(overlays.contact_lines(sim.contacts.point, sim.contacts.normal))
-        if flags.velocities:
-            parts.append(overlays.velocity_arrows(positions, np.asarray(spheres.velocities)))
+        if flags.contacts and shown.contact_points is not None:
+            parts.append(overlays.contact_lines(shown.contact_points, shown.contact_normals))
+        if flags.velocities and shown.velocities is not None and len(shown.velocities) == len(positions):
+            parts.append(overlays.velocity_arrows(positions, shown.velocities))
         if extra_lines is not None and len(extra_lines):
             parts.append(extra_lines)
         if parts:
@@ -75,19 +76,18 @@ class FrameFeeder:
         self.renderer.upload_lines(world_lines, overlay_lines)
         self.upload_seconds = time.perf_counter() - started
 
-    def _upload_ghosts(self, sim: Simulation) -> None:
+    def _upload_ghosts(self, shown: Shown) -> None:
         """Every ghost world's balls, tinted by integrator, as one translucent instance set."""
         from .ghosts import GHOST_ALPHA, TINTS
 
-        ghosts = sim.timeline.ghost_worlds()
+        ghosts = shown.ghosts
         if not ghosts:
             self.renderer.upload_ghosts(np.zeros((0, 3)), np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3)))
             return
-        spheres = [g.spheres for _, g in ghosts]
         self.renderer.upload_ghosts(
-            np.concatenate([s.positions for s in spheres]),
-            np.concatenate([s.orientations for s in spheres]),
-            np.concatenate([s.radii for s in spheres]),
-            np.concatenate([np.broadcast_to(TINTS[name], (len(g.spheres), 3)) for name, g in ghosts]),
+            np.concatenate([g[1] for g in ghosts]),
+            np.concatenate([g[2] for g in ghosts]),
+            np.concatenate([g[3] for g in ghosts]),
+            np.concatenate([np.broadcast_to(TINTS[name], (len(p), 3)) for name, p, _, _ in ghosts]),
             GHOST_ALPHA,
         )

@@ -13,60 +13,66 @@ from collections.abc import Sequence
 import pyglet
 
 from .controls import HELP
-from .simulation import Phase, Simulation
+from .handover import HudFacts
+from .simulation import Simulation
 
 FONT = ("DejaVu Sans Mono", "Menlo", "Consolas", "Courier New", "monospace")
 FONT_SIZE = 11
 TEXT_COLOR = (235, 238, 245, 255)
 ERROR_COLOR = (255, 110, 100, 255)
 PANEL_COLOR = (10, 12, 18, 190)
+ERROR_BACK = (10, 12, 18, 225)  # the dark box under the error text, so red reads on the grey ground
 MARGIN = 10
+NO_WRAP = 4000  # px: labels wider than any window, so lines break only where the text says
 MESSAGE_SECONDS = 3.0
 
 
 def hud_lines(
-    sim: Simulation,
+    sim: Simulation | HudFacts,
     fly_speed: float,
     overlays: str,
     extra: Sequence[str] = (),
     shot_speed: float | None = None,
 ) -> list[str]:
     """The HUD's text: time, speed, integrator, step rate, counts, energy, fly (and shot) speed,
-    ``extra`` lines and the run state."""
-    world = sim.world
-    state = sim.phase.value
-    if sim.phase is Phase.RUNNING and sim.time_scale != 1.0:
-        state = f"running at ×{sim.time_scale:g}"
+    ``extra`` lines and the run state. ``sim``: a Simulation, or the facts the physics handed over."""
+    f = sim if isinstance(sim, HudFacts) else HudFacts.of(sim)
     return [
-        f"{sim.appearance.name}",
-        f"sim time    {world.time:9.3f} s",
-        f"time scale  ×{sim.time_scale:g}   real-time factor {sim.real_time_factor:.2f}",
-        f"integrator  {world.integrator.upper():5s} dt {sim.timestep * 1000:.2f} ms",
-        f"steps/s     {sim.steps_per_second:9.0f}",
-        f"balls       {sim.ball_count:9d}",
-        f"contacts    {sim.last_step_contacts:9d}",
-        f"kinetic E   {sim.kinetic_energy():9.3f} J",
+        f"{f.name}",
+        f"sim time    {f.time:9.3f} s",
+        f"time scale  ×{f.time_scale:g}   real-time factor {f.real_time_factor:.2f}",
+        f"integrator  {f.integrator.upper():5s} dt {f.timestep * 1000:.2f} ms",
+        f"steps/s     {f.steps_per_second:9.0f}",
+        f"balls       {f.balls:9d}",
+        f"contacts    {f.contacts:9d}",
+        f"kinetic E   {f.kinetic_energy:9.3f} J",
         f"fly speed   {fly_speed:9.2f} m/s" + ("" if shot_speed is None else f"  shot {shot_speed:g} m/s"),
         f"overlays    {overlays or 'none'} (C V T)",
         *extra,
-        f"state       {state}",
-        *timeline_lines(sim),
+        f"state       {f.state}",
+        *f.timeline,
         "F1 help  F2 profile  H hide",
     ]
 
 
-def profile_lines(sim: Simulation) -> list[str]:
-    """The HUD's profile page: where the step's time went over the last second, stage by stage
-    (``World.profile``, like Box2D's b2Profile), with intervals, pairs and contacts per step."""
+def profile_body(sim: Simulation) -> list[str]:
+    """The profile page's lines after its title: where the step's time went over the last second,
+    stage by stage (``World.profile``, like Box2D's b2Profile), with intervals, pairs and contacts per
+    step; empty before any step."""
     p = sim.profile
     if not p.steps:
-        return [f"{sim.appearance.name}: step profile", "no steps yet (X drops)", "F2 back  H hide"]
-    return [
-        f"{sim.appearance.name}: step profile, {p.steps} steps",
-        f"{'stage':<15}{'per step':>12}",
-        *p.lines(),
-        "F2 back  H hide",
-    ]
+        return []
+    return [f"{p.steps} steps", f"{'stage':<15}{'per step':>12}", *p.lines()]
+
+
+def profile_lines(sim: Simulation | HudFacts, drawn: Sequence[str] = ()) -> list[str]:
+    """The HUD's profile page (F2): the step's time by stage, then ``drawn`` (what draws the window:
+    the GL renderer and the quality)."""
+    f = sim if isinstance(sim, HudFacts) else HudFacts.of(sim)
+    drawn = list(drawn)
+    if not f.profile:
+        return [f"{f.name}: step profile", "no steps yet (X drops)", *drawn, "F2 back  H hide"]
+    return [f"{f.name}: step profile, {f.profile[0]}", *f.profile[1:], *drawn, "F2 back  H hide"]
 
 
 def timeline_lines(sim: Simulation) -> list[str]:
@@ -79,7 +85,7 @@ def timeline_lines(sim: Simulation) -> list[str]:
     if timeline.replay is not None:
         lines.append(f"replay      {timeline.replay.trajectory.path.name}")
     elif span is not None and timeline.history is not None and timeline.history.in_past:
-        lines.append(f"history     {span[2] - span[1]:.3f} s in the past (Space resumes from here)")
+        lines.append(f"history     {span[2] - span[1]:.3f} s in the past; Space resumes")
     for name, drift, main in timeline.drifts():
         what = "run  " if main else "ghost"
         unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"
@@ -112,9 +118,10 @@ class Hud:
         self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
         self.label = pyglet.text.Label(
-            "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=460,
+            "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=NO_WRAP,
             anchor_y="top", batch=self.batch,
         )  # fmt: skip
+        self.error_back = pyglet.shapes.Rectangle(0, 0, 10, 10, color=ERROR_BACK)
         self.error_label = pyglet.text.Label(
             "", font_name=FONT, font_size=FONT_SIZE, color=ERROR_COLOR, multiline=True, width=900,
             anchor_y="bottom",
@@ -124,9 +131,10 @@ class Hud:
         )
         self.help_panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.help_batch)
         self.help_label = pyglet.text.Label(
-            help_text(), font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=620,
+            help_text(), font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=NO_WRAP,
             anchor_x="center", anchor_y="center", batch=self.help_batch,
         )  # fmt: skip
+        self.help_label.width = self.help_label.content_width + 2  # centred on its own lines, unwrapped
         self.layout()
 
     def layout(self) -> None:
@@ -135,6 +143,9 @@ class Hud:
         self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
         self.error_label.width = max(w - 2 * MARGIN, 100)
         self.error_label.x, self.error_label.y = MARGIN, MARGIN + self.bottom
+        label = self.error_label
+        self.error_back.position = (label.x - 5, label.y - 3)
+        self.error_back.width, self.error_back.height = label.content_width + 10, label.content_height + 6
         self.message_label.x = MARGIN
         self.message_label.y = (
             MARGIN + self.bottom + (self.error_label.content_height + 6 if self.error else 0)
@@ -204,6 +215,7 @@ class Hud:
         if self.show_hud and not (self.show_help and self.help_hides_hud):
             self.batch.draw()
         if self.error:
+            self.error_back.draw()
             self.error_label.draw()
         if self.message_shown(now):
             self.message_label.draw()

@@ -123,9 +123,10 @@ class Interaction:
 
     def throw_velocity(self) -> np.ndarray:
         """The held ball's velocity: its motion over the last ``THROW_WINDOW`` seconds of frames."""
-        if len(self._samples) < 2:
+        samples = list(self._samples)  # one copy: the window reads it while the physics side appends
+        if len(samples) < 2:
             return np.zeros(3)
-        (t0, p0), (t1, p1) = self._samples[0], self._samples[-1]
+        (t0, p0), (t1, p1) = samples[0], samples[-1]
         return (p1 - p0) / (t1 - t0) if t1 > t0 else np.zeros(3)
 
     # ------------------------------------------------------------------ per frame

@@ -7,10 +7,14 @@ simulate`` of the scene for as many steps, bit for bit. Balls added while runnin
 from the step after they appear. A reset (R) or a reload starts the timeline again from its new start.
 Resuming from the past (after stepping back through the history) drops the records of the steps that
 were dropped, so the record holds the timeline as it stands, with no step twice.
+
+The steps are recorded on the physics thread and the file is written from the window's when it closes,
+so both hold the recorder's lock: a step that ends after the file was written is not recorded.
 """
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 from ballpit.writers import TrajectoryWriter
@@ -25,16 +29,19 @@ class Recorder:
         self.path = Path(path)
         self.sim = sim
         self.finished = False
+        self._lock = threading.Lock()
         self._start()
         sim.after_step.append(self.record)
         sim.after_reset.append(self.restart)
         sim.after_resume_from_past.append(self.cut)
 
-    def _start(self) -> None:
+    def _writer(self) -> TrajectoryWriter:
         # one record per chunk, so the steps after a point in the past can be cut off again
-        self.writer = TrajectoryWriter(
-            self.path, len(self.sim.world.spheres), option="--record", records_per_chunk=1
-        )
+        balls = len(self.sim.world.spheres)
+        return TrajectoryWriter(self.path, balls, option="--record", records_per_chunk=1)
+
+    def _start(self) -> None:
+        self.writer = self._writer()
         self.record()  # where the run starts
 
     @property
@@ -44,8 +51,11 @@ class Recorder:
 
     def record(self) -> None:
         """Step hook: append the world's state now."""
-        if self.finished:
-            return
+        with self._lock:
+            if not self.finished:
+                self._record()
+
+    def _record(self) -> None:
         history = self.sim.timeline.history
         if history is not None:  # a step taken after the future was dropped (resumed or edited in the past)
             self.writer.truncate(history.current)
@@ -57,20 +67,26 @@ class Recorder:
 
     def cut(self, step: int) -> None:
         """Resume hook: the run goes on from ``step`` (since the start); later records are dropped."""
-        if not self.finished:
-            self.writer.truncate(step + 1)
+        with self._lock:
+            if not self.finished:
+                self.writer.truncate(step + 1)
 
     def restart(self) -> None:
         """Reset hook: the timeline starts again from the new world's start."""
-        if self.finished:
-            return
-        self.writer.discard()
-        self._start()
+        with self._lock:
+            if self.finished:
+                return
+            self.writer.discard()
+            self.writer = self._writer()
+            self._record()
 
-    def finish(self) -> Path | None:
-        """Write the file (once); returns its path, or None if it was written already."""
-        if self.finished:
-            return None
-        self.finished = True
-        self.writer.commit()
-        return self.path
+    def finish(self) -> tuple[Path, int, int] | None:
+        """Write the file (once); returns (its path, the steps recorded, the balls), or None if it was
+        written already."""
+        with self._lock:
+            if self.finished:
+                return None
+            self.finished = True
+            steps, balls = self.steps, self.writer.n
+            self.writer.commit()
+            return self.path, steps, balls

@@ -14,7 +14,7 @@ from .energyplot import legend as plot_legend
 from .energyplot import plot_shapes
 from .hud import FONT, TEXT_COLOR
 from .overlays import VERTEX_WIDTH
-from .simulation import Simulation
+from .stepper import PhysicsThread
 
 BAR_MARGIN = 10  # px from the window's sides and bottom
 BAR_HEIGHT = 14
@@ -61,9 +61,9 @@ def bar_shapes(width: int, fraction: float) -> np.ndarray:
 class ScreenOverlay:
     """The timeline bar and the energy plot of one viewer window."""
 
-    def __init__(self, window: pyglet.window.Window, sim: Simulation) -> None:
+    def __init__(self, window: pyglet.window.Window, physics: PhysicsThread) -> None:
         self.window = window
-        self.sim = sim
+        self.physics = physics  # the bar and plot draw what it handed over; scrubbing is a command to it
         self.show_plot = False
         self.scrubbing = False
         self.bar_label = pyglet.text.Label(
@@ -74,7 +74,7 @@ class ScreenOverlay:
 
     @property
     def bar_shown(self) -> bool:
-        return self.sim.timeline.source is not None
+        return self.physics.shown.bar is not None
 
     def bottom_clearance(self) -> int:
         """Pixels the bar and its label take at the bottom (the HUD puts its messages above them)."""
@@ -94,14 +94,17 @@ class ScreenOverlay:
         if not self.on_bar(x, y):
             return False
         self.scrubbing = True
-        self.sim.scrub(self._fraction_at(x))
+        self._scrub(self._fraction_at(x))
         return True
 
     def drag(self, x: float, y: float) -> bool:
         if not self.scrubbing:
             return False
-        self.sim.scrub(self._fraction_at(x))
+        self._scrub(self._fraction_at(x))
         return True
+
+    def _scrub(self, fraction: float) -> None:
+        self.physics.submit(lambda sim: sim.scrub(fraction))
 
     def release(self) -> bool:
         was, self.scrubbing = self.scrubbing, False
@@ -112,22 +115,23 @@ class ScreenOverlay:
         """Build this frame's bar and plot geometry and hand it to the renderer."""
         width, height = self.window.width, self.window.height
         triangles, lines = [], []
-        timeline = self.sim.timeline
-        source = timeline.source
-        if source is not None:
-            triangles.append(bar_shapes(width, source.fraction()))
-            oldest, now, newest = timeline.span()
-            kind = "replay" if timeline.replay is not None else "history"
-            self.bar_label.text = f"{kind}  {now:.3f} s of {oldest:.2f}–{newest:.2f} s  (drag to scrub)"
+        shown = self.physics.shown
+        bar = shown.bar
+        if bar is not None:
+            triangles.append(bar_shapes(width, bar.fraction))
+            text = f"{bar.kind}  {bar.now:.3f} s of {bar.oldest:.2f}–{bar.newest:.2f} s  (drag to scrub)"
+            if self.bar_label.text != text:
+                self.bar_label.text = text
             self.bar_label.x = width - BAR_MARGIN
             self.bar_label.y = BAR_MARGIN + BAR_HEIGHT + BAR_LABEL_GAP
-        if self.show_plot:
+        if self.show_plot and shown.energy is not None:
             rect = plot_rect(width, height)
-            ghosts = timeline.ghosts is not None
-            panel, curves, (low, high) = plot_shapes(timeline.energy, rect, ghosts)
+            ghosts = bool(shown.ghosts)
+            panel, curves, (low, high) = plot_shapes(shown.energy, rect, ghosts)
             triangles.append(panel)
             lines.append(curves)
-            self._plot_labels(rect, low, high, plot_legend(timeline.energy.series(), ghosts))
+            legend = plot_legend(shown.energy.series(), ghosts)
+            self._plot_labels(rect, low, high, legend, shown.energy.window)
         empty = np.zeros((0, VERTEX_WIDTH), dtype=np.float32)
         renderer.upload_screen(  # type: ignore[attr-defined]
             np.concatenate(triangles) if triangles else empty,
@@ -135,9 +139,11 @@ class ScreenOverlay:
             (width, height),
         )
 
-    def _plot_labels(self, rect: tuple, low: float, high: float, items: list[tuple[str, tuple]]) -> None:
+    def _plot_labels(
+        self, rect: tuple, low: float, high: float, items: list[tuple[str, tuple]], window: float
+    ) -> None:
         x, y, _, h = rect
-        texts = [(f"energy, last {self.sim.timeline.energy.window:g} s   {low:.3g} … {high:.3g} J",
+        texts = [(f"energy, last {window:g} s   {low:.3g} … {high:.3g} J",
                   TEXT_COLOR, x, y + h + 4)]  # fmt: skip
         for text, color in items:
             texts.append((text, tuple(round(c * 255) for c in color[:3]) + (255,), 0, y + 4))

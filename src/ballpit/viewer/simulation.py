@@ -12,6 +12,7 @@ No GL here, and nothing per ball in Python: everything works on whole arrays.
 from __future__ import annotations
 
 import copy
+import itertools
 import os
 import sys
 import time
@@ -32,6 +33,9 @@ TRAIL_POINT_BUDGET = 200_000  # trail samples kept over all balls
 TRAIL_MAX_SAMPLES = 120
 TRAIL_INTERVAL = 1.0 / 30.0  # simulated seconds between trail samples
 STATS_WINDOW = 0.5  # wall seconds over which steps/s and the real-time factor are measured
+
+
+_GENERATIONS = itertools.count(1)
 
 
 class Phase(Enum):
@@ -124,7 +128,7 @@ class Simulation:
         self.initial = copy.deepcopy(world)
         self._signature = _file_signature(self.path)
         self._reset_dynamics()
-        self.generation += 1
+        self.generation = next(_GENERATIONS)  # unique across Simulations too
 
     def _reset_dynamics(self) -> None:
         spheres = self.world.spheres

@@ -1,0 +1,11 @@
+#version 330 core
+// The 3-D view, drawn at a lower resolution, stretched over the whole window: one triangle that
+// covers the screen (corners from gl_VertexID, no vertex buffer).
+
+out vec2 v_uv;
+
+void main() {
+    vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // (0,0) (2,0) (0,2)
+    v_uv = corner;
+    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}

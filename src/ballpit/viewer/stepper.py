@@ -1,0 +1,204 @@
+"""Physics beside the drawing: a thread of its own steps the Simulation; the window draws what it hands over.
+
+As in MuJoCo's ``simulate``, the window owns input and drawing and the physics owns the World, and they
+meet at one small hand-over: after each batch of steps the physics thread captures a ``Shown`` (see
+handover.py) and swaps it in under a lock; the window draws the latest one. Whatever a step costs, the
+window keeps drawing and answering keys, and quitting never waits for a step in progress (the thread
+is a daemon and is never joined).
+
+Everything the window asks of the World (keys, picking and throwing, tilting planes, B, reload, Ctrl+S)
+is a command, ``submit(fn)``: the physics side runs ``fn(sim)`` between steps, never in the middle of
+one, and the window gets its result back in ``deliver`` on its own thread (where GL and pyglet live).
+
+Two ways to run:
+
+- free (``run_free``): the thread steps on the wall clock, through ``Simulation.advance`` (a fixed
+  timestep from an accumulator; when a step costs more than real time the backlog is dropped, so the
+  HUD's real-time factor is simulated seconds over wall seconds, as measured);
+- lockstep (``advance(dt)``): the caller's thread takes the lock and advances exactly ``dt`` of real
+  time, applying the commands first. Tests and scripted runs use it for exact, repeatable frames.
+
+A thread rather than a process, by the figures of benchmarks/physics_beside_drawing.py on a 2-core
+machine with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s
+with the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17
+and 17); with slopes.toml stepping flat out, 15 and 19 frames/s against 16 and 16 (194 and 225 steps/s
+against 177 and 182). A process buys nothing here: the two cores are shared with llvmpipe's own
+threads either way, and the GL driver and NumPy's large operations release the GIL. A thread keeps
+every World-touching feature (history, ghosts, recording, picking, saving) in one address space with
+plain function calls as commands. The GIL switch interval is lowered while it runs so the window,
+coming back from a GL call, waits at most about a millisecond for the physics to let go.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from .handover import HudFacts, Needs, Shown, capture
+from .simulation import Phase, Simulation
+
+HUD_INTERVAL = 0.1  # seconds between readings of the HUD's facts (energy, drifts, profile)
+IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no command came
+IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
+# s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
+# wait for the GIL when it comes back from a GL call while the physics holds it
+SWITCH_INTERVAL = float(os.environ.get("BALLPIT_SWITCH", "0.001"))
+
+Command = Callable[[Simulation], Any]
+Then = Callable[[Any], None]
+
+
+class PhysicsThread:
+    """Steps one Simulation beside the window and hands over a ``Shown`` after every batch of steps."""
+
+    def __init__(self, sim: Simulation, needs: Callable[[], Needs] = Needs) -> None:
+        self.sim = sim
+        self.needs = needs  # what the window draws now (asked at each capture)
+        self.lock = threading.Lock()  # held while the World changes: a step, a command, a capture
+        self._handover_lock = threading.Lock()
+        self._commands: deque[tuple[Command, Then | None]] = deque()
+        self._results: deque[tuple[Then, Any]] = deque()
+        self._wake = threading.Event()
+        self._free = False
+        self._restart_clock = True
+        self._stopped = False
+        self._hud: HudFacts | None = None
+        self._hud_at = 0.0
+        self.crash: str | None = None  # an error that stopped the thread (shown in the HUD)
+        self.captures = 0
+        with self.lock:
+            self._shown = self._capture(force_hud=True)
+        self._previous_switch = sys.getswitchinterval()
+        sys.setswitchinterval(SWITCH_INTERVAL)
+        self._thread = threading.Thread(target=self._run, name="ballpit physics", daemon=True)
+        self._thread.start()
+
+    # ------------------------------------------------------------------ the window's side
+    @property
+    def shown(self) -> Shown:
+        """The latest finished state handed over."""
+        with self._handover_lock:
+            return self._shown
+
+    def submit(self, command: Command, then: Then | None = None) -> None:
+        """Run ``command(sim)`` on the physics side between steps; ``then(result)`` later in ``deliver``."""
+        self._commands.append((command, then))
+        self._wake.set()
+
+    def run_free(self) -> None:
+        """Step on the wall clock from now on (the window's real-time loop)."""
+        if not self._free:
+            self._restart_clock = True
+            self._free = True
+            self._wake.set()
+
+    def advance(self, seconds: float) -> int:
+        """Lockstep: stop running free, then advance exactly ``seconds`` of real time here (waiting for a
+        step in progress to end). Returns the steps taken."""
+        self._free = False
+        with self.lock:
+            self._apply_commands()
+            steps = self.sim.advance(seconds)
+            self._publish(force_hud=False)
+        self.deliver()
+        return steps
+
+    def sync(self) -> None:
+        """Apply the pending commands now, waiting for a step in progress (tests and scripted runs)."""
+        with self.lock:
+            self._apply_commands()
+            self._publish(force_hud=True)
+        self.deliver()
+
+    def deliver(self) -> None:
+        """Run the ``then`` callbacks of finished commands, on the caller's (the window's) thread."""
+        while self._results:
+            then, result = self._results.popleft()
+            then(result)
+
+    def refresh_hud(self) -> None:
+        """Read the HUD's facts again at the next capture (after a key changed what it shows)."""
+        self._hud_at = 0.0
+
+    def stop(self) -> None:
+        """Stop stepping. Never waits for a step in progress: the daemon thread ends after it, or with the
+        process."""
+        self._stopped = True
+        self._free = False
+        self._wake.set()
+        sys.setswitchinterval(self._previous_switch)
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()
+
+    # ------------------------------------------------------------------ the physics side
+    def _run(self) -> None:
+        last = published = time.perf_counter()
+        while not self._stopped:
+            if not self._free:
+                self._wake.wait(IDLE_WAIT)
+                self._wake.clear()
+                continue
+            wait = IDLE_WAIT
+            with self.lock:
+                if not self._free or self._stopped:
+                    continue
+                try:
+                    commands = self._apply_commands()
+                    now = time.perf_counter()
+                    if self._restart_clock:
+                        self._restart_clock, last = False, now
+                    steps = self.sim.advance(now - last)
+                    last = now
+                    if steps or commands or now - published >= IDLE_HANDOVER:  # else the same as before:
+                        self._publish(force_hud=False)  # the window may keep the view it drew
+                        published = now
+                except Exception as exc:  # never let the thread die silently: say why in the HUD
+                    self.crash = f"physics thread stopped: {type(exc).__name__}: {exc}"
+                    self.sim.error = self.crash
+                    self._publish(force_hud=True)
+                    print(f"ballpit: {self.crash}", file=sys.stderr, flush=True)
+                    return
+                sim = self.sim
+                if sim.phase is Phase.RUNNING:  # sleep until the next step is due
+                    wait = max(sim.timestep - sim.accumulator, 0.0) / max(sim.time_scale, 1e-9)
+            if wait > 0.0:
+                self._wake.wait(min(wait, IDLE_WAIT))
+                self._wake.clear()
+
+    def _apply_commands(self) -> int:
+        """Run the commands sent so far; returns how many."""
+        count = 0
+        while self._commands:
+            count += 1
+            command, then = self._commands.popleft()
+            try:
+                result = command(self.sim)
+            except Exception as exc:  # a failed command is reported, the physics goes on
+                result = exc
+                self.sim.error = f"{type(exc).__name__}: {exc}"
+                print(f"ballpit: {self.sim.error}", file=sys.stderr, flush=True)
+            if then is not None:
+                self._results.append((then, result))
+        return count
+
+    def _capture(self, force_hud: bool) -> Shown:
+        now = time.perf_counter()
+        needs = self.needs()
+        hud = self._hud
+        if force_hud or hud is None or now >= self._hud_at or not needs.hud:
+            hud = HudFacts.of(self.sim)
+            self._hud, self._hud_at = hud, now + HUD_INTERVAL
+        self.captures += 1
+        return capture(self.sim, needs, hud=hud)
+
+    def _publish(self, force_hud: bool) -> None:
+        shown = self._capture(force_hud)
+        with self._handover_lock:
+            self._shown = shown

@@ -1,0 +1,59 @@
+"""The HUD's and the help's text breaks only where the text says (no wrapping mid-phrase), and the
+error sits on a dark box so its red reads on the grey ground."""
+
+from __future__ import annotations
+
+import pytest
+
+
+def line_height(hud) -> float:
+    import pyglet
+
+    from ballpit.viewer.hud import FONT, FONT_SIZE
+
+    one = pyglet.text.Label("Xg", font_name=FONT, font_size=FONT_SIZE, multiline=True, width=4000)
+    two = pyglet.text.Label("Xg\nXg", font_name=FONT, font_size=FONT_SIZE, multiline=True, width=4000)
+    return two.content_height - one.content_height
+
+
+@pytest.fixture
+def hud(offscreen):
+    from ballpit.viewer.hud import Hud
+
+    return Hud(offscreen.window)
+
+
+def test_the_help_is_laid_out_one_row_per_binding(hud):
+    from ballpit.viewer.hud import help_text
+
+    rows = help_text().count("\n") + 1
+    step = line_height(hud)
+    assert hud.help_label.content_height == pytest.approx(rows * step, abs=step * 0.6)
+    assert hud.help_label.width >= hud.help_label.content_width  # its lines fit: none is broken
+
+
+def test_a_long_hud_line_stays_one_line(hud):
+    lines = ["slopes.toml", "history     12.500 s in the past; Space resumes", "x" * 90]
+    hud.set_text(lines)
+    step = line_height(hud)
+    assert hud.label.content_height == pytest.approx(len(lines) * step, abs=step * 0.6)
+    assert hud.panel.width >= hud.label.content_width  # the panel grows to fit the line
+
+
+def test_the_error_is_drawn_on_a_dark_box_that_covers_it(hud):
+    from ballpit.viewer.hud import ERROR_BACK, ERROR_COLOR
+
+    hud.set_error("reload of live.toml failed: sphere #1: radius must be positive, got -0.3")
+    label, box = hud.error_label, hud.error_back
+    assert box.x <= label.x and box.x + box.width >= label.x + label.content_width
+    assert box.y <= label.y and box.y + box.height >= label.y + label.content_height
+    assert sum(ERROR_BACK[:3]) < 60 and ERROR_BACK[3] >= 200  # dark and nearly opaque
+
+    # WCAG contrast of the red on the box: well above the 4.5 asked of body text
+    def luminance(rgb):
+        c = [v / 255 for v in rgb]
+        c = [v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4 for v in c]
+        return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+
+    ratio = (luminance(ERROR_COLOR[:3]) + 0.05) / (luminance(ERROR_BACK[:3]) + 0.05)
+    assert ratio > 4.5

@@ -1,0 +1,118 @@
+"""The physics thread beside the window (stepper.py) and its hand-over (handover.py): commands run
+between steps and never inside one, results come back on the caller's thread, lockstep frames are
+exact, the real-time factor is what the physics managed, and stopping never waits for a step."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import numpy as np
+
+from ballpit.viewer.handover import Needs, capture
+from ballpit.viewer.simulation import Phase, Simulation
+from ballpit.viewer.stepper import PhysicsThread
+
+from .conftest import line_of_balls
+
+
+def wait_for(condition, timeout: float = 10.0) -> bool:
+    end = time.monotonic() + timeout
+    while not condition() and time.monotonic() < end:
+        time.sleep(0.005)
+    return condition()
+
+
+def test_lockstep_frames_advance_exactly_the_time_given_and_apply_commands_first():
+    sim = Simulation(line_of_balls(3), step_budget=math.inf)
+    physics = PhysicsThread(sim)
+    try:
+        physics.submit(lambda s: s.start())
+        for _ in range(30):
+            physics.advance(1.0 / 60.0)
+        assert sim.phase is Phase.RUNNING
+        assert sim.steps_total == 120  # 0.5 s at 1/240 s
+        np.testing.assert_array_equal(physics.shown.positions, sim.render_state()[0])  # interpolated
+        assert physics.shown.bar.now == 120 * sim.timestep  # every hand-over is of the state now
+        physics.sync()  # the HUD's facts are read at most 10 times a second, or when asked
+        assert physics.shown.hud.time == sim.world.time
+    finally:
+        physics.stop()
+
+
+def test_commands_sent_while_it_runs_free_are_applied_between_steps_and_answered_on_the_callers_thread():
+    sim = Simulation(line_of_balls(3))
+    inside = []
+    sim.before_step.append(lambda: inside.append(True))
+    sim.after_step.append(lambda: inside.pop())
+    physics = PhysicsThread(sim)
+    seen, answers = [], []
+    try:
+        physics.submit(lambda s: s.start())
+        physics.run_free()
+        assert wait_for(lambda: sim.steps_total > 20)
+        for k in range(20):
+            physics.submit(lambda s, k=k: (seen.append((bool(inside), threading.get_ident())), k)[1],
+                           lambda k: answers.append((k, threading.get_ident())))  # fmt: skip
+            time.sleep(0.003)
+        assert wait_for(lambda: len(seen) == 20)
+        physics.deliver()
+    finally:
+        physics.stop()
+    assert not any(mid_step for mid_step, _ in seen)  # never inside a step
+    assert {ident for _, ident in seen} == {physics._thread.ident}  # on the physics thread
+    assert answers == [(k, threading.get_ident()) for k in range(20)]  # in order, back on this thread
+
+
+def test_the_real_time_factor_is_what_slow_steps_manage_not_the_time_scale():
+    """Each step made to take 20 ms of wall time: at most 50 steps of 1/240 s a second, a real-time
+    factor of at most 50/240 = 0.21, whatever is asked."""
+    sim = Simulation(line_of_balls(3))
+    sim.before_step.append(lambda: time.sleep(0.02))
+    physics = PhysicsThread(sim)
+    try:
+        physics.submit(lambda s: s.start())
+        physics.run_free()
+        assert wait_for(lambda: sim.real_time_factor > 0.0)
+        time.sleep(1.2)
+        factor, steps_per_second = sim.real_time_factor, sim.steps_per_second
+    finally:
+        physics.stop()
+    assert 0.0 < factor <= 50 * sim.timestep * 1.05
+    assert factor == np.float64(steps_per_second * sim.timestep) or math.isclose(
+        factor, steps_per_second * sim.timestep, rel_tol=1e-9
+    )
+
+
+def test_stop_returns_at_once_in_the_middle_of_a_long_step():
+    sim = Simulation(line_of_balls(3))
+    started = threading.Event()
+
+    def long_step() -> None:
+        started.set()
+        time.sleep(1.0)
+
+    sim.before_step.append(long_step)
+    physics = PhysicsThread(sim)
+    physics.submit(lambda s: s.start())
+    physics.run_free()
+    assert started.wait(10)
+    t = time.perf_counter()
+    physics.stop()
+    assert time.perf_counter() - t < 0.1
+    assert physics.lock.locked()  # the step is still running: it was not waited for
+    assert wait_for(lambda: not physics.alive, 5.0)  # and the thread ends after it, taking no more
+
+
+def test_the_handover_is_a_copy_that_later_steps_leave_alone():
+    sim = Simulation(line_of_balls(3), step_budget=math.inf)
+    sim.start()
+    sim.advance(0.1)
+    shown = capture(sim, Needs(velocities=True, trails=True))
+    positions, velocities = shown.positions.copy(), shown.velocities.copy()
+    sim.advance(0.1)
+    np.testing.assert_array_equal(shown.positions, positions)
+    np.testing.assert_array_equal(shown.velocities, velocities)
+    assert not np.array_equal(sim.world.spheres.positions, positions)
+    assert shown.hud.time < sim.world.time and shown.trails is not None
