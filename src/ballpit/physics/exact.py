@@ -90,5 +90,6 @@ def sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     c = one + (((1.0 - one) - half) + (z * c_poly - hi * lo))
     quarter = np.mod(n, 4.0)
     sin = np.where(quarter == 0.0, s, np.where(quarter == 1.0, c, np.where(quarter == 2.0, -s, -c)))
+    sin = np.where(x == 0.0, x, sin)  # sin(−0) = −0, which the reduction's subtractions lose
     cos = np.where(quarter == 0.0, c, np.where(quarter == 1.0, -s, np.where(quarter == 2.0, -c, s)))
     return sin, cos
