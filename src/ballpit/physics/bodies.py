@@ -14,7 +14,7 @@ from typing import Protocol, overload
 
 import numpy as np
 
-from . import collision, validation
+from . import collision, exact, validation
 from .model import Model
 from .state import Columns, Q, State, V, W, X
 
@@ -191,7 +191,7 @@ class Plane(_Body):
     def signed_distance(self, points: object) -> np.ndarray | float:
         """Signed distance of points from the plane's infinite extension, positive on the normal's side."""
         p = np.asarray(points, float)
-        d = (p - self.position) @ self.normal
+        d = exact.dot(p - self.position, self.normal)
         return float(d) if p.ndim == 1 else d
 
     def closest_point(self, points: object) -> np.ndarray:

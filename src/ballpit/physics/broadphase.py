@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import exact
+
 # The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
 _OFFSETS = np.array(
     [(0, 0, 0)]
@@ -215,9 +217,9 @@ def sphere_plane_pairs(
     spheres, planes = [], []
     for p in range(len(center)):
         d = box_center - center[p]
-        du = np.abs(d @ axis_u[p]) - half_size[p, 0]
-        dv = np.abs(d @ axis_v[p]) - half_size[p, 1]
-        dn = d @ normal[p]
+        du = np.abs(exact.dot(d, axis_u[p])) - half_size[p, 0]
+        dv = np.abs(exact.dot(d, axis_v[p])) - half_size[p, 1]
+        dn = exact.dot(d, normal[p])
         # distance from the box centre to the rectangle, against the box's bounding-sphere radius
         dist2 = np.maximum(du, 0.0) ** 2 + np.maximum(dv, 0.0) ** 2 + dn**2
         if sweep is None:

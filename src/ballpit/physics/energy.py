@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import exact
 from .model import Model
 from .state import State, V, W, X
 
@@ -13,12 +14,11 @@ def kinetic(model: Model, state: State) -> float:
     """Translational plus rotational kinetic energy, Σ ½·m·v² + ½·I·ω² (J)."""
     sph, body = model.spheres, state.body
     v, w = body[:, V], body[:, W]
-    return float(
-        0.5 * (sph.mass @ np.einsum("ij,ij->i", v, v))
-        + 0.5 * ((1.0 / sph.inv_inertia) @ np.einsum("ij,ij->i", w, w))
+    return 0.5 * exact.total(sph.mass * np.einsum("ij,ij->i", v, v)) + 0.5 * exact.total(
+        (1.0 / sph.inv_inertia) * np.einsum("ij,ij->i", w, w)
     )
 
 
 def potential(model: Model, state: State) -> float:
     """Gravitational potential energy −Σ m·g·x (J), zero at the origin."""
-    return float(-(model.spheres.mass @ (state.body[:, X] @ model.gravity)))
+    return -exact.total(model.spheres.mass * exact.dot(state.body[:, X], model.gravity))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import exact
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
 from .state import Columns
@@ -119,4 +120,4 @@ class Model:
         """
         if self.restitution_threshold is not None:
             return self.restitution_threshold
-        return self.integrator.threshold_steps * float(np.linalg.norm(self.gravity)) * dt
+        return self.integrator.threshold_steps * float(exact.norm(self.gravity)) * dt

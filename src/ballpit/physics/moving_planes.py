@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import quaternion
+from . import exact, quaternion
 from .model import Model
 from .state import Columns, State
 
@@ -21,7 +21,7 @@ def set_orientation(pose: Columns, i: int, q: np.ndarray) -> None:
     axes = quaternion.rotate(q, np.eye(3))  # rows: the plane's x, y (normal) and z axes
     pose.full("orientation")[i] = q
     pose.full("axis_u")[i] = axes[0]
-    pose.full("normal")[i] = axes[1] / np.linalg.norm(axes[1])
+    pose.full("normal")[i] = axes[1] / exact.norm(axes[1])
     pose.full("axis_v")[i] = axes[2]
 
 
@@ -67,8 +67,8 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     """How far a point of ``plane`` within ``distance`` of its centre can move in ``h``:
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
-    shift = float(np.linalg.norm(pl.velocity[plane])) * h
-    return shift + float(np.linalg.norm(pl.angular_velocity[plane])) * h * (distance + shift)
+    shift = float(exact.norm(pl.velocity[plane])) * h
+    return shift + float(exact.norm(pl.angular_velocity[plane])) * h * (distance + shift)
 
 
 def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.ndarray, v: np.ndarray,

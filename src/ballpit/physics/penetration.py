@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jacobi, solver
+from . import exact, jacobi, solver
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
@@ -66,11 +66,11 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray) -
     if moved.size == 0:
         return
     mass = model.spheres.mass[moved]
-    lift = -float(mass @ ((new[moved] - old[moved]) @ model.gravity))
+    lift = -exact.total(mass * exact.dot(new[moved] - old[moved], model.gravity))
     if lift <= 0.0:
         return
     v = state.body[moved, V]
-    kinetic = 0.5 * float(mass @ np.einsum("ij,ij->i", v, v))
+    kinetic = 0.5 * exact.total(mass * np.einsum("ij,ij->i", v, v))
     scale = np.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
     state.body[moved, V] = v * scale
 
@@ -90,15 +90,17 @@ def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.nd
     start, path = old[moved], new[moved] - old[moved]
     t = np.ones(len(moved))
     for p in range(model.planes.count):
-        d0 = (start - pose.center[p]) @ pose.normal[p]
-        d1 = d0 + path @ pose.normal[p]
+        d0 = exact.dot(start - pose.center[p], pose.normal[p])
+        d1 = d0 + exact.dot(path, pose.normal[p])
         crossing = (d0 >= 0.0) != (d1 >= 0.0)
         if not crossing.any():
             continue
         k = np.flatnonzero(crossing)
         through = start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k]  # where the centre crosses
         rel = through - pose.center[p]
-        inside = (np.abs(rel @ pose.axis_u[p]) <= half[p, 0]) & (np.abs(rel @ pose.axis_v[p]) <= half[p, 1])
+        inside = (np.abs(exact.dot(rel, pose.axis_u[p])) <= half[p, 0]) & (
+            np.abs(exact.dot(rel, pose.axis_v[p])) <= half[p, 1]
+        )
         k = k[inside]
         # stop at the signed distance ±min(r, |d0|): touching it, on the side the ball came from
         stop = np.sign(d0[k]) * np.minimum(radius[k], np.abs(d0[k]))

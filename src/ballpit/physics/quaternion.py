@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import exact
+
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 
@@ -45,8 +47,8 @@ def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
 def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rotation by ``angle`` radians about the unit vector ``axis``."""
     axis = np.asarray(axis, float)
-    half = 0.5 * np.asarray(angle, float)[..., None]
-    return np.concatenate((axis * np.sin(half), np.cos(half)), axis=-1)
+    sin, cos = exact.sin_cos(0.5 * np.asarray(angle, float)[..., None])
+    return np.concatenate((axis * sin, cos), axis=-1)
 
 
 def from_euler_xyz(degrees: np.ndarray) -> np.ndarray:
@@ -65,7 +67,7 @@ def from_up_to(normal: np.ndarray) -> np.ndarray:
     """The shortest rotation taking +y to the unit vector ``normal`` (180° about x when it is −y)."""
     n = np.asarray(normal, float)
     up = np.array([0.0, 1.0, 0.0])
-    d = float(np.dot(up, n))
+    d = float(exact.dot(up, n))
     if d < -1.0 + 1e-12:
         return np.array([1.0, 0.0, 0.0, 0.0])
     # q = (up × n, 1 + up·n) normalised is the half-angle form of the rotation between them.

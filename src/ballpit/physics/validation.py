@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from . import exact
 from . import quaternion as rotations
 
 # What the engine can step: far enough inside float64 that squares, products and sums of these never
@@ -78,7 +79,7 @@ def unit_vector(name: str, value: object) -> np.ndarray:
     biggest = float(np.abs(v).max())
     if biggest > 1.0:
         v = v / biggest
-    norm = float(np.linalg.norm(v))
+    norm = float(exact.norm(v))
     if norm < 1e-12:
         raise ValueError(f"{name} must not be a zero vector, got {value!r}")
     return v / norm
@@ -90,7 +91,7 @@ def quaternion(name: str, value: object) -> np.ndarray:
     biggest = float(np.abs(q).max())
     if biggest > 1.0:
         q = q / biggest
-    norm = float(np.linalg.norm(q))
+    norm = float(exact.norm(q))
     if norm < 1e-12:
         raise ValueError(f"{name} must not be a zero quaternion, got {value!r}")
     return q / norm

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..physics import World
+from ..physics import World, exact
 from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls
@@ -192,7 +192,7 @@ class Builder:
             orientation=(
                 np.array(d["orientation"], dtype=float)
                 if orientation is None
-                else orientation / np.linalg.norm(orientation)
+                else orientation / exact.norm(orientation)
             ),
             restitution=e.number("restitution", d["restitution"], nonnegative=True),
             friction=e.number("friction", d["friction"], nonnegative=True),

@@ -1,0 +1,95 @@
+"""Arithmetic whose bits do not depend on the CPU, for everything a step computes.
+
+A scene gives the same bits on any x86-64 machine only if every operation in the step does. These do:
+elementwise +, −, ×, ÷ and sqrt are correctly rounded (IEEE 754) on every CPU and SIMD width, and a
+sum taken in an order fixed by the code is too. These do not, so the step avoids them:
+
+- matrix products (``@``, ``np.dot``, ``np.matmul``, ``np.linalg.norm`` of a 1-D vector, which is a
+  dot product): OpenBLAS picks its kernel by CPU (``OPENBLAS_CORETYPE``), and the kernels sum in
+  different orders, some with fused multiply-adds;
+- NumPy's transcendental functions (``np.sin``, ``np.cos``, ``np.exp``, ...): some have SIMD variants
+  chosen by CPU (``NPY_DISABLE_CPU_FEATURES``), and the rest call the C library, whose ``sin`` and
+  ``cos`` also pick an FMA variant by CPU (glibc's ``GLIBC_TUNABLES=glibc.cpu.hwcaps``). Python's
+  ``math.sin`` is that same C function, so it is no way out either.
+
+NumPy's ``einsum`` without ``optimize`` and ``np.add.reduce`` over a short axis are compiled once for
+the baseline CPU (they have no CPU-dispatched variants), so the per-row dot products written with
+them elsewhere give the same bits everywhere too; ``tests/test_determinism.py`` checks the bundled
+scenes under each switch.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# π/2 in three pieces for Cody–Waite reduction (fdlibm's e_rem_pio2.c): the first two have 33
+# significant bits, so n·piece is exact for |n| < 2**20; _PIO2_2T is what the first two lack.
+_INV_PIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_2T = 2.02226624879595063154e-21
+# Minimax polynomials for sin and cos on [−π/4, π/4] (FreeBSD msun k_sin.c and k_cos.c, < 1 ulp).
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+# Beyond this the reduction's n·piece products are no longer exact: larger angles are first taken
+# modulo the double nearest 2π (np.fmod is exact), which is off by under 1e-9 rad there, less than
+# the spacing of the angles themselves (2e-10 rad at 2¹⁹·π).
+_MAX_ANGLE = 2.0**19 * np.pi
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a · b over the last axis, summed from first to last: (a₀b₀ + a₁b₁) + a₂b₂ for 3-vectors."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    out = a[..., 0] * b[..., 0]
+    for k in range(1, max(a.shape[-1], b.shape[-1])):
+        out = out + a[..., k] * b[..., k]
+    return out
+
+
+def norm(a: np.ndarray) -> np.ndarray:
+    """|a| over the last axis, its squares summed from first to last (as ``np.linalg.norm(a,
+    axis=-1)`` sums them for rows of a matrix, but without its dot product for a single vector)."""
+    return np.sqrt(dot(a, a))
+
+
+def total(x: np.ndarray) -> float:
+    """Σx from first to last, one addition at a time (an accumulation is sequential by definition,
+    unlike a matrix product's kernel)."""
+    x = np.ravel(x)
+    return float(np.cumsum(x)[-1]) if x.size else 0.0
+
+
+def sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """sin and cos of ``angle`` (radians) from +, −, × only, within 1 ulp for |angle| < 2¹⁹·π.
+
+    The angle is reduced to r + r_lo in [−π/4, π/4] by n quarter turns (Cody–Waite, π/2 in three
+    pieces), then fdlibm's polynomials give sin r and cos r, and n mod 4 picks the signs and order.
+    """
+    x = np.asarray(angle, float)
+    x = np.where(np.abs(x) > _MAX_ANGLE, np.fmod(x, 2.0 * np.pi), x)
+    n = np.rint(x * _INV_PIO2)
+    # fdlibm's two-step medium reduction: r = x − n·π/2 with the rounding of each step carried in r_lo
+    t = x - n * _PIO2_1
+    w = n * _PIO2_2
+    r = t - w
+    w = n * _PIO2_2T - ((t - r) - w)
+    hi = r - w
+    lo = (r - hi) - w
+    z = hi * hi
+    zz = z * z
+    # k_sin: r + r³·S(r²), with the reduction's tail lo added to first order
+    v = z * hi
+    s_poly = _S2 + z * (_S3 + z * _S4) + z * zz * (_S5 + z * _S6)
+    s = hi - ((z * (0.5 * lo - v * s_poly) - lo) - v * _S1)
+    # k_cos: 1 − r²/2 + r⁴·C(r²), the 1 − r²/2 split so its rounding error is kept
+    c_poly = z * (_C1 + z * (_C2 + z * _C3)) + zz * zz * (_C4 + z * (_C5 + z * _C6))
+    half = 0.5 * z
+    one = 1.0 - half
+    c = one + (((1.0 - one) - half) + (z * c_poly - hi * lo))
+    quarter = np.mod(n, 4.0)
+    sin = np.where(quarter == 0.0, s, np.where(quarter == 1.0, c, np.where(quarter == 2.0, -s, -c)))
+    sin = np.where(x == 0.0, x, sin)  # sin(−0) = −0, which the reduction's subtractions lose
+    cos = np.where(quarter == 0.0, c, np.where(quarter == 1.0, -s, np.where(quarter == 2.0, -c, s)))
+    return sin, cos
