@@ -17,7 +17,7 @@ import numpy as np
 from . import collision, moving_planes
 from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
-from .pairs import CONTACT_SLOP
+from .pairs import contact_slop
 from .state import State, V, X, with_static
 
 # Impacts whose times are this close (as an overlap, in radii) are resolved together: a pile of 1,000
@@ -82,7 +82,8 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     IMPACT_OVERLAP of the smallest radius (removed next interval by moving positions). A lone impact is
     always met exactly.
     """
-    when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * CONTACT_SLOP)
+    slop = contact_slop(model)
+    when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop)
     hit = np.isfinite(when)
     if not hit.any():
         return np.inf
@@ -109,7 +110,7 @@ def meetings(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h:
     """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
     ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
     all (their indices into ``c``)."""
-    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+    apart = np.flatnonzero(c.gap >= contact_slop(model))
     none = np.zeros(0)
     if apart.size == 0:
         return none, none, apart
@@ -208,7 +209,7 @@ def threatened(model: Model, state: State, c: ContactPoints, accel: np.ndarray, 
     bounded as in ``next_impact``). A (N,) mask."""
     n = model.spheres.count
     hit = np.zeros(n + 1, bool)
-    apart = np.flatnonzero(c.gap >= CONTACT_SLOP)
+    apart = np.flatnonzero(c.gap >= contact_slop(model))
     if apart.size:
         body, path = state.body, model.integrator
         speed = np.append(np.linalg.norm(body[:, V], axis=1), 0.0)
