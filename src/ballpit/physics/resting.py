@@ -79,11 +79,7 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
     if rows.moving and model.planes.angular_velocity.any():  # the contacts at the interval's end
-        # where a ball ends depends on its contact forces too: the warm start stands in for them
-        v_warm, w_warm = v.copy(), w.copy()
-        solver.warm_start(rows, v_warm, w_warm, imp)
-        rows = moving_planes.rows_at_end(model, state, c, rows, lin + (v_warm[:-1] - v[:-1]) / h, h)
-        imp = warm.impulses(keys, rows.normal, h)
+        rows = moving_planes.rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, target, imp, model.solver_iterations, jacobi_from=jacobi_from)
     if h >= WARM_START_SPAN * dt:
