@@ -75,10 +75,11 @@ def test_a_failing_row_shows_the_childs_error_and_exits_non_zero(tmp_path, monke
     assert lines[2:] == ["ballpit bench: 2 of 2 measurements failed"]
 
 
-def test_bench_times_the_slopes_demo_with_its_own_five_balls(capsys):
-    assert bench.main(["--workload", "slopes", "--steps", "3", "--pybullet-up-to", "10"]) == 0
+@pytest.mark.parametrize("demo", ["slopes", "seesaw"])
+def test_bench_times_a_demo_with_its_own_five_balls(capsys, demo):
+    assert bench.main(["--workload", demo, "--steps", "3", "--pybullet-up-to", "10"]) == 0
     table = [line.split() for line in capsys.readouterr().out.splitlines() if line.startswith("ballpit  ")]
-    assert [(r[1], int(r[2]), int(r[3])) for r in table] == [("slopes", 5, 3)]
+    assert [(r[1], int(r[2]), int(r[3])) for r in table] == [(demo, 5, 3)]
     assert float(table[0][4]) > 0
 
 

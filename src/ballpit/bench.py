@@ -1,5 +1,5 @@
 """Step-rate benchmarks: free flight, a falling grid of balls piling into a box, a pile at rest, and
-the slopes demo.
+the slopes and see-saw demos.
 
 Every measurement runs in its own process (``python -m ballpit.bench --one ...``) so engines and sizes
 do not share caches or memory, and so the peak resident memory per ball can be read honestly.
@@ -9,6 +9,7 @@ PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile 
     ballpit bench --workload pile --sizes 1000,10000 --pybullet --plot scaling.png
     ballpit bench --workload settled --sizes 1000,10000,100000   # cost growth in a pile at rest
     ballpit bench --workload slopes --steps 2400   # the slopes demo headless, 10 s of it
+    ballpit bench --workload seesaw --steps 1440   # the see-saw demo headless, its 6 s (a turning plank)
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ from .arguments import OneLineParser, count, one_line, positive
 DT = 1 / 240
 RADIUS = 0.05
 SPACING = 0.11
+# The bundled demos timed as they are (workloads named after their scenes).
+DEMOS = ("slopes", "seesaw")
 
 
 @dataclass
@@ -96,10 +99,10 @@ def _box_layout(workload: str, n: int) -> tuple[np.ndarray, float]:
 def _ballpit_world(workload: str, n: int):
     import ballpit
 
-    if workload == "slopes":  # the bundled demo as it is (its own ball count; ``n`` is not used)
+    if workload in DEMOS:  # the bundled demo as it is (its own ball count; ``n`` is not used)
         from .scene import read_scene, resolve_scene_path
 
-        return read_scene(resolve_scene_path("slopes")).world
+        return read_scene(resolve_scene_path(workload)).world
     world = ballpit.World(integrator="rk4")
     if workload == "free":
         rng = np.random.default_rng(0)
@@ -170,7 +173,7 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
     seconds = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
     if engine == "ballpit":
-        n = len(world.spheres)  # the slopes demo has its own
+        n = len(world.spheres)  # a demo has its own
     return Result(engine, workload, n, steps, seconds, (peak - base) * 1024.0 / n)
 
 
@@ -283,10 +286,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = OneLineParser(prog="ballpit bench", description=description)
     parser.add_argument(
         "--workload",
-        choices=("free", "pile", "settled", "slopes", "all"),
+        choices=("free", "pile", "settled", *DEMOS, "all"),
         default="all",
         help="free flight; a grid falling into a box (the pile forming); a pile already at rest; or the "
-        "slopes demo headless (its own 5 balls; --sizes does not apply, PyBullet has no such scene)",
+        "slopes or see-saw demo headless (their own 5 balls; --sizes does not apply, PyBullet has no "
+        "such scene)",
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument(
@@ -336,8 +340,7 @@ def main(argv: list[str] | None = None) -> int:
         plan += [("pile", n) for n in (args.sizes or [1_000, 10_000])]
     if args.workload in ("settled", "all"):
         plan += [("settled", n) for n in (args.sizes or [1_000, 10_000, 100_000])]
-    if args.workload in ("slopes", "all"):
-        plan += [("slopes", 0)]
+    plan += [(demo, 0) for demo in DEMOS if args.workload in (demo, "all")]
     machine = platform.processor() or platform.machine()
     versions = f"Python {platform.python_version()}, NumPy {np.__version__}"
     print(f"ballpit bench: {machine}, {versions}, dt = 1/240 s, RK4, each row in its own process")
@@ -348,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
     for workload, n in plan:
         steps = args.steps or 240  # one simulated second
         with_pybullet = args.pybullet and (args.pybullet_up_to is None or n <= args.pybullet_up_to)
-        with_pybullet = with_pybullet and workload != "slopes"
+        with_pybullet = with_pybullet and workload not in DEMOS
         # PyBullet first, so ballpit's row can show the ratio to it as soon as it is printed.
         engines = (["pybullet"] if with_pybullet else []) + ["ballpit"]
         for engine in engines:

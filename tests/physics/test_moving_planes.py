@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.physics.pairs import CONTACT_SLOP
 from ballpit.physics.penetration import OVERLAP_TOLERANCE
 
 G = 9.81
@@ -113,6 +114,31 @@ def test_square_tilted_under_a_resting_ball_never_lets_it_sink_then_it_rolls_at_
     a = (float(ball.velocity @ downhill) - v0) / t
     assert a == pytest.approx(5 / 7 * G * sin_theta, rel=1e-6)
     assert ball.angular_velocity == pytest.approx(np.cross(n, ball.velocity) / r, abs=1e-6)
+
+
+@pytest.mark.parametrize("hz", RATES)
+@pytest.mark.parametrize("speed", [2.0, -2.0])
+def test_ball_rolling_across_a_turning_plank_keeps_contact_in_one_interval_a_step(hz, speed):
+    # A see-saw plank turning at constant ω under a ball rolling along it at s. Solved against the
+    # contact as it is at the start of each step, the ball ended each step approaching or leaving the
+    # plank at about 2·ω·s·dt (the turning frame's Coriolis term): rolling one way it sank 7 µm (240 Hz)
+    # to 110 µm (60 Hz) into the plank, the other way it floated beyond the 10 µm contact slop and
+    # every step split at its little falls (up to 9 intervals a step).
+    rate, r = 0.2, 0.2
+    world = ballpit.World()
+    plank = world.add_plane(size=(12.0, 4.0), angular_velocity=(0, 0, rate), friction=0.6)
+    ball = world.add_sphere(position=(0, r, 0), radius=r, velocity=(speed, 0, 0),
+                            angular_velocity=(0, 0, -speed / r), friction=0.6)  # fmt: skip
+    for _ in range(hz):  # one second: the plank tilts 11.5° and the ball rolls about 2 m along it
+        world.step(1 / hz)
+        assert world.profile.intervals == 1
+        gap = plank.signed_distance(ball.position) - r
+        assert -0.5e-6 < gap < CONTACT_SLOP  # touching, and not sinking
+        # no jitter: the ball moves with the plank's surface under it along the normal (µm/s)
+        under = ball.position - r * plank.normal - plank.position
+        surface = np.cross(plank.angular_velocity, under)
+        assert (ball.velocity - surface) @ plank.normal == pytest.approx(0.0, abs=2e-6)
+    assert abs(ball.position[0]) > 1.5  # it did roll along the plank
 
 
 def test_plane_motion_is_validated_and_kept_in_snapshots():

@@ -200,3 +200,38 @@ def test_the_bundled_pile_lands_with_overlaps_under_a_tenth_of_a_radius_and_rest
     assert world.crowded_steps > 100  # it really landed as a crowd
     assert landing < 0.10
     assert resting < 0.01
+
+
+@pytest.mark.parametrize("speed", [1e-3, 0.1])
+def test_a_100_nm_ball_stays_in_a_20_micrometre_box_and_rests_on_its_radius(speed):
+    # The contact slop was a fixed 10 µm: half this box. Every ball touched several walls at once, so
+    # none was ever stopped at one, and at 0.1 m/s they left the box in the first step; on the floor
+    # they hovered microns up. Tolerances are now fractions of the smallest radius where that is less.
+    side, r = 20e-6, 100e-9
+    world = ballpit.World()
+    closed_box(world, side=side)
+    rng = np.random.default_rng(1)
+    low, high = (
+        (-side / 2 + 2 * r, 2 * r, -side / 2 + 2 * r),
+        (side / 2 - 2 * r, side - 2 * r, side / 2 - 2 * r),
+    )
+    velocity = rng.normal(size=(5, 3))
+    velocity *= speed / np.linalg.norm(velocity, axis=1)[:, None]
+    world.add_spheres(rng.uniform(low, high, (5, 3)), radius=r, velocity=velocity)
+    for _ in range(120):
+        world.step(1 / 240)
+        assert inside(world, side=side)
+    if speed < 0.01:  # slow ones have settled onto the floor: on their radius, not microns up
+        assert world.spheres.positions[:, 1] == pytest.approx(r, rel=1e-3)
+
+
+def test_a_step_that_would_carry_balls_beyond_the_steppable_range_is_undone_not_taken():
+    # step(1e6) let ten free balls fall 4.9e12 m, and the next step then refused the world's own state.
+    world = ballpit.World()
+    world.add_spheres(np.c_[np.arange(10.0), np.ones(10), np.zeros(10)], radius=0.2)
+    with pytest.raises(ValueError, match=r"sphere #0 has beyond 1e\+09 in its position.*undone"):
+        world.step(1e6)
+    assert world.time == 0.0
+    assert world.spheres.positions[:, 1] == pytest.approx(np.ones(10))  # where they were
+    world.step(1 / 240)  # and the world steps on from there
+    assert world.spheres.positions[0, 1] == pytest.approx(1 - 0.5 * 9.81 / 240**2)

@@ -17,15 +17,20 @@ from .model import Model
 from .rows import ContactRows
 from .state import State, V, X, with_static
 
-# Overlaps shallower than this (m) are left alone: rounding, not penetration.
+# Overlaps shallower than this (m) are left alone: rounding, not penetration …
 OVERLAP_TOLERANCE = 1e-7
+# … or than this fraction of the smallest ball's radius, if that is less (a 100 nm ball could otherwise
+# sink its whole radius into a wall).
+OVERLAP_PER_RADIUS = 1e-5
 # Gauss–Seidel sweeps over the overlapping contacts.
 SWEEPS = 4
 
 
 def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
     """Move overlapping balls apart along the contact normals (positions only), never through a plane."""
-    if not np.any(c.gap < -OVERLAP_TOLERANCE):
+    radius = model.spheres.radius
+    tolerance = min(OVERLAP_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
+    if not np.any(c.gap < -tolerance):
         return
     x = state.body[:, X]
     pos = with_static(x)

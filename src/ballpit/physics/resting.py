@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import solver
+from . import moving_planes, solver
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
@@ -78,6 +78,8 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     v_free, w_free = v.copy(), w.copy()
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
+    if rows.moving and model.planes.angular_velocity.any():  # the contacts at the interval's end
+        rows = moving_planes.rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, target, imp, model.solver_iterations, jacobi_from=jacobi_from)
     if h >= WARM_START_SPAN * dt:

@@ -23,7 +23,7 @@ from .contacts import SPHERE_PLANE, ContactPoints, EventLog
 from .forces import ConstantPerBall, ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
 from .model import Model
-from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache
+from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache, contact_slop
 from .profile import StepProfile
 from .state import State, V, W, with_static
 
@@ -126,7 +126,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         if not first:
             with prof.stage("narrow phase"):
                 contacts = narrowphase.contact_points(model, state, pairs)
-        touching = contacts.subset(contacts.gap < CONTACT_SLOP)
+        touching = contacts.subset(contacts.gap < contact_slop(model))
         with prof.stage("contact rows"):
             batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):

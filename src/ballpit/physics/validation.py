@@ -158,25 +158,39 @@ _SMALLEST_LIMIT = float(_STATE_LIMITS.min())
 def reject_unsteppable_state(body: np.ndarray) -> None:
     """Refuse to step from a NaN/inf, or a value beyond what the engine can step, written straight
     into the arrays (the setters check theirs)."""
+    bad = _unsteppable(body)
+    if bad is not None:
+        raise ValueError(f"sphere #{bad}; the world was not stepped")
+
+
+def _unsteppable(body: np.ndarray) -> str | None:
+    """The first ball whose state the engine cannot step, with what is wrong ("3 has a non-finite
+    velocity (nan)"), or None."""
     # Every value within the smallest limit passes: two passes over the block, no temporaries (a NaN
     # makes max and min NaN, which fails too). Only then is it looked at field by field.
     if len(body) == 0 or (body.max() <= _SMALLEST_LIMIT and body.min() >= -_SMALLEST_LIMIT):
-        return
+        return None
     bad = ~(np.abs(body) <= _STATE_LIMITS)  # NaN compares false
     if not bad.any():
-        return
+        return None
     row, col = np.argwhere(bad)[0]
     field, _, _, limit = next(f for f in _STATE_FIELDS if f[1] <= col < f[2])
     what = "a non-finite" if not np.isfinite(body[row, col]) else f"beyond {limit:g} in its"
-    raise ValueError(f"sphere #{row} has {what} {field} ({body[row, col]}); the world was not stepped")
+    return f"{row} has {what} {field} ({body[row, col]})"
 
 
 def undo_non_finite_step(body: np.ndarray, before: np.ndarray) -> None:
-    """Keep the world free of NaN/inf: restore the state and raise if a step produced any."""
+    """Keep the world free of NaN/inf, and of values the next step would refuse: restore the state and
+    raise if a step produced any (``step(1e6)`` let balls fall 5e12 m, and the next step then refused
+    the world's own state)."""
     if not np.isfinite(body).all():
         bad = int(np.flatnonzero(~np.isfinite(body).all(axis=1))[0])
         body[:] = before
         raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
+    beyond = _unsteppable(body)
+    if beyond is not None:
+        body[:] = before
+        raise ValueError(f"after the step sphere #{beyond}; the step was undone (take shorter steps)")
 
 
 def _symmetric(limit: float) -> tuple[float, float]:
