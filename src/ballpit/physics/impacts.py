@@ -62,11 +62,7 @@ APPROACH_SPEED = 1e-6
 def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Each contact's normal speed v_n (negative: closing), from the (N+1, 3) velocities ``v`` and
     spins ``w`` (row N the static world), relative to a moving plane's surface."""
-    va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
-    rel = va + np.cross(wa, rows.arm_a) - vb - np.cross(wb, rows.arm_b)
-    if rows.moving:
-        rel -= rows.surface
-    n = c.normal
+    rel, n = _relative_velocity(c, rows, v, w), c.normal
     return rel[:, 0] * n[:, 0] + rel[:, 1] * n[:, 1] + rel[:, 2] * n[:, 2]
 
 
