@@ -41,6 +41,12 @@ conservative advancement, to the earliest time a pair's gap along its normal cou
 rolling fast just above a surface made it crawl, 48 steps and a split of the step at a time); only
 pairs that had needed more than 8 steps change, and slopes, cradle and pile have none in their first
 2 s.
+billiards, gas, pile10k, seesaw and slopes, when the split step began to bounce in waves (#24): only
+the contacts arriving take part in a bounce (a break passes the cue ball's impulse through the rack
+ball by ball; resting contacts under a bouncing ball no longer join its solve), what a wave sets
+closing bounces in turn, slower approaches are stopped after the waves, and normal speeds are summed
+component by component. cradle (its balls 1 mm apart), incline and pile are unchanged. cannon and
+cradle_touching were added with it.
 """
 
 from __future__ import annotations
@@ -57,15 +63,17 @@ SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SECONDS = 2.0
 RUN_SECONDS = {"pile10k": 0.7}  # the rest run SECONDS
 HASHES = {
-    "slopes": "36a8528b8a18082bac38998ec34ed841d60f3bf0a8fd2f051c23942bf69ce775",
-    "cradle": "4f893dd8f2d151d5883149cd93af3aaefba83ccc7d8289a6121a877faad1150d",
-    "billiards": "023af0524170b5a2d9f050d4c01e29a3d27d2c43ce0060d50181b28606faf21d",
-    "incline": "6ca212819d67c114b8ca2f7d5d49b05eb5e102c362d94034fc4b3052193024b0",
-    "gas": "79e162b84f53a910af613dc94d8d339dee9ff8d29570023a3c7c26e15d627db8",
-    "pile": "d80abd852f1aa8407eeaf86923e4a15ae80d6c2527042c6b1063f6d4cc60c227",
-    "pile10k": "c5b82663b29554607405c3f1e1787699920e4827a9789aada2d7800b06c73131",
-    "seesaw": "0fdb66b70c0af5b2b8dd5f15bfca2f877f72d9fa1a2b63ee646f21244a83d2cc",
-    "integrators": "32f989f23c6d7c8d2f45df00b23ad46abd660e8028d24f1560c2201684005e1f",
+    "slopes": "TBD",
+    "cradle": "TBD",
+    "cradle_touching": "TBD",
+    "cannon": "TBD",
+    "billiards": "TBD",
+    "incline": "TBD",
+    "gas": "TBD",
+    "pile": "TBD",
+    "pile10k": "TBD",
+    "seesaw": "TBD",
+    "integrators": "TBD",
 }
 
 

@@ -22,7 +22,18 @@ from .cli_runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-REQUIRED = {"slopes", "cradle", "billiards", "incline", "pile", "pile10k", "seesaw", "integrators"}
+REQUIRED = {
+    "slopes",
+    "cradle",
+    "cradle_touching",
+    "cannon",
+    "billiards",
+    "incline",
+    "pile",
+    "pile10k",
+    "seesaw",
+    "integrators",
+}
 # Enough simulated time to exercise each scene while keeping the suite fast (big piles: a few steps).
 SHORT_RUN = {"pile": 3, "pile10k": 2, "gas": 3, "billiards": 20}  # steps
 DEFAULT_STEPS = 24
@@ -152,6 +163,34 @@ def test_integrators_agree_at_first_then_part_ways(tmp_path):
     # all three lose energy to the drag only: the walls and balls are perfectly elastic and smooth
     speeds = {k: np.linalg.norm(r[:, :, 5:8], axis=2) for k, r in runs.items()}
     assert all((s[five] ** 2).sum() < (s[0] ** 2).sum() for s in speeds.values())
+def test_touching_cradle_sends_off_two_balls_when_two_strike(tmp_path):
+    """Two touching strikers at 2 m/s hit five touching balls: the strikers and the three first balls
+    stop, the last two leave at 2 m/s (impacts in waves), and energy is kept."""
+    traj, _, _ = simulate_csv(tmp_path, "cradle_touching", "--duration", "0.6")
+    last = traj[-7:]  # balls in scene order: the two strikers, then the row left to right
+    assert np.allclose(last[:5, 5], 0, atol=0.04), "the strikers and the first three balls stop"
+    assert last[5:, 5] == pytest.approx([2.0, 2.0], rel=0.02), "the last two leave at the strikers' speed"
+    world = load_scene(SCENES / "cradle_touching.toml")
+    energy = 0.5 * float(np.sum(world.spheres.masses * np.sum(world.spheres.velocities**2, axis=1)))
+    assert 0.5 * float(np.sum(world.spheres.masses * np.sum(last[:, 5:8] ** 2, axis=1))) == pytest.approx(
+        energy, rel=1e-3
+    )
+
+
+def test_cannon_throws_its_top_ball_far_above_where_it_was_dropped_from(tmp_path):
+    """The three stacked balls land together; the top one rises to the closed-form height of two
+    elastic impacts in turn (floor, big on middle, middle on top), more than four times its start."""
+    traj, _, _ = simulate_csv(tmp_path, "cannon", "--duration", "2.5")
+    world = load_scene(SCENES / "cannon.toml")
+    (m1, m2, m3), (r1, r2, r3) = world.spheres.masses, world.spheres.radii
+    start = float(world.spheres.positions[2, 1])
+    v = math.sqrt(2 * 9.81 * (float(world.spheres.positions[0, 1]) - r1))  # landing speed
+    v2 = (3 * m1 - m2) / (m1 + m2) * v  # the middle ball off the bounced big one
+    v3 = ((m3 - m2) * -v + 2 * m2 * v2) / (m2 + m3)  # the top ball off the middle one
+    apex = 2 * r1 + 2 * r2 + r3 + v3 * v3 / (2 * 9.81)
+    top = traj[2::3, 3].max()
+    assert top == pytest.approx(apex, rel=0.01)
+    assert top > 4 * start
 
 
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):

@@ -183,3 +183,29 @@ def test_still_means_below_the_sleep_speed_in_translation_and_in_spin():
     for _ in range(round(TIME_TO_SLEEP / DT) + 4):
         world.step(DT)
     assert world.asleep.tolist() == [False, True]  # spinning at 1.5× the sleep speed; drifting at half
+
+
+@pytest.mark.parametrize("sleep", [False, True])
+def test_a_closed_elastic_frictionless_box_never_gains_energy_with_sleeping_on_or_off(sleep):
+    # A layer of balls resting apart on the floor (they fall asleep after TIME_TO_SLEEP when sleeping
+    # is on) and six balls flying above them; e = 1 and no friction anywhere, so no step may add
+    # energy. Steps only lose it where slow arrivals stop (below the restitution threshold).
+    from tests.physics.test_robustness import closed_box
+
+    rng = np.random.default_rng(1)
+    world = ballpit.World(sleep=sleep)
+    closed_box(world, friction=0.0)
+    r = 0.08
+    layer = np.stack(np.meshgrid(np.arange(5), np.arange(5), indexing="ij"), -1).reshape(-1, 2) * 0.35 - 0.7
+    world.add_spheres(np.column_stack((layer[:, 0], np.full(25, r), layer[:, 1])), radius=r, friction=0.0)
+    above = np.column_stack((rng.uniform(-0.8, 0.8, 6), rng.uniform(1.0, 1.8, 6), rng.uniform(-0.8, 0.8, 6)))
+    world.add_spheres(above, radius=r, friction=0.0, velocity=rng.normal(0, 1.0, (6, 3)))
+    energy = world.kinetic_energy() + world.potential_energy()
+    slept = 0
+    for _ in range(720):
+        world.step(DT)
+        now = world.kinetic_energy() + world.potential_energy()
+        assert now <= energy + 1e-12 * abs(energy)
+        energy = now
+        slept = max(slept, int(world.asleep.sum()))
+    assert (slept >= 20) == sleep

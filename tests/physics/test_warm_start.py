@@ -10,7 +10,7 @@ import ballpit
 
 DT = 1 / 240
 SHELF = (40.0, 0.0, 0.0)  # a far-away shelf, out of reach of the pile
-SETTLE = 720  # steps: 3 s, time for the pile to come to rest (it does within about 2.3 s)
+SETTLE = 960  # steps (4 s: the column topples, and a ball rolls to a wall; all rest by about 3.3 s)
 
 
 def settled_pile() -> ballpit.World:

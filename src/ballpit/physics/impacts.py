@@ -1,12 +1,39 @@
 """Impacts: contacts arriving faster than the restitution threshold leave at e times their approach
-speed (Newton's impact law, v_n' = −e·v_n), solved over the island of contacts around them.
+speed (Newton's impact law, v_n' = −e·v_n).
 
-The touching contacts within BOUNCE_HOPS balls of an arriving one take part, so a ball landing on a
-stack pushes through it, and momentum passes down a line of touching balls (Newton's cradle).
-Contacts arriving slower than the threshold just stop (target v_n' = 0).
+The rule is **impacts in waves** (``in_waves``): simultaneous within a wave, sequential between waves.
+
+- A wave is the set of contacts arriving now: closing faster than the restitution threshold. Only they
+  take part. A contact that touches but does not close is no part of the wave, so it cannot share
+  the impulse: that is what makes a touching Newton's cradle move on as one block in every engine
+  that solves the touching contacts together (an LCP over the whole island; Smith, Kaufman, Vouga,
+  Tamstorf and Grinspun, "Reflections on simultaneous impact", SIGGRAPH 2012, compare the rules).
+- The wave's contacts are solved together, each to v_n' ≥ −e·v_n, with P_n ≥ 0 and P_n = 0 wherever
+  v_n' ends above its target (an LCP over the wave alone). A ball struck from two sides in the same
+  wave is struck by both at once.
+- Then the contacts are measured again: those the wave set closing (the next ball in the chain, the
+  small ball on top of a big one that has just bounced off the floor) form the next wave, from their
+  new approach speeds. This repeats until nothing arrives, at most MAX_WAVES times.
+
+What it keeps: momentum, in every wave (impulses are equal and opposite). Energy: with every contact
+of a wave arriving (v_n < 0), the wave's LCP changes the kinetic energy by
+½·Σ P_i·(1 − e_i)·v_n,i ≤ 0 (frictionless; zero when e = 1), so no wave adds energy. An iterative solve
+that has not quite converged could still add a little, so each wave's impulses are checked and scaled
+down until it adds none (``_keep_energy``); scaling impulses keeps momentum.
+
+What it gives: a touching cradle struck by one ball passes the impulse down the line and only the
+last ball leaves; struck by two, two leave; the Galilean cannon's top ball leaves at
+(3M − m)/(M + m)·v. A ball struck from two sides at once (two contacts in one wave) gets the
+simultaneous answer: equal balls at ±v on a ball at rest go back at ∓v and it stays; at 2 and −1
+m/s they leave at −4/3 and 5/3 and the middle one at 2/3 (energy and momentum kept).
+
+At the bound: what still closes after MAX_WAVES waves is stopped, e = 0, by ``stop_approaches``
+(an inelastic impact never adds energy). So are the slower approaches, after the waves.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -17,7 +44,14 @@ from .rows import ContactRows
 from .solver import Impulses
 from .state import State, V, W, with_static
 
-# The bounce is solved over the contacts within this many balls of an arriving one.
+# The most waves one impact sets off; what still arrives after them is stopped (e = 0). A touching
+# line needs one wave per ball.
+MAX_WAVES = 64
+# A wave is solved until no contact's speed changes by more than 1e-9 m/s in a sweep, or this many
+# sweeps (at least the world's solver_iterations): a ball struck from two sides needs about 15.
+WAVE_ITERATIONS = 50
+# The stop (and the crowded step's bounce) is solved over the contacts within this many balls of a
+# closing one.
 BOUNCE_HOPS = 3
 # A bounce is solved afresh (no warm start, nothing to hold at rest): Jacobi sweeps per iteration.
 BOUNCE_JACOBI_SWEEPS = 1
@@ -25,26 +59,92 @@ BOUNCE_JACOBI_SWEEPS = 1
 APPROACH_SPEED = 1e-6
 
 
-def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
-           allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
-           seeds_among: np.ndarray | None = None, jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
-    """Bounce the contacts that arrive, with their island; velocities change in place.
+def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Each contact's normal speed v_n (negative: closing), from the (N+1, 3) velocities ``v`` and
+    spins ``w`` (row N the static world), relative to a moving plane's surface."""
+    rel, n = _relative_velocity(c, rows, v, w), c.normal
+    return rel[:, 0] * n[:, 0] + rel[:, 1] * n[:, 1] + rel[:, 2] * n[:, 2]
 
-    ``allowance`` (m/s) is how fast each contact may close without being stopped: zero for a
-    touching contact, gap/dt for a speculative one, which therefore arrives only faster than that and
-    otherwise keeps closing at that speed. With ``arrivals_only`` only arrivals faster than the
-    threshold start an island; otherwise any approach does (and the slow ones in it just stop).
-    ``seeds_among``, when given, is where islands may start (other contacts only join them).
+
+def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
+             allowance: np.ndarray, events: EventLog, now: float, *,
+             jacobi_from: int = solver.JACOBI_FROM) -> int:  # fmt: skip
+    """Bounce the contacts of ``c`` that arrive, wave after wave (the module's rule); velocities
+    change in place. Returns the number of waves.
+
+    ``allowance`` (m/s) is how fast each contact may close without being stopped: zero for a touching
+    contact, gap/dt for a speculative one, which therefore arrives only when it closes faster than
+    that (and faster than ``threshold``). Slower approaches are left alone (``stop_approaches``).
+    """
+    if len(c) == 0:
+        return 0
+    v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
+    keys = None
+    waves = 0
+    iterations = max(model.solver_iterations, WAVE_ITERATIONS)
+    while waves < MAX_WAVES:
+        vn = normal_speeds(c, rows, v, w)
+        arriving = (vn < -(allowance + APPROACH_SPEED)) & (-vn > threshold)
+        if not arriving.any():
+            break
+        idx = np.flatnonzero(arriving)
+        wave = rows.subset(idx)
+        before = _velocities(wave, v, w)
+        imp = solver.solve(wave, v, w, -wave.restitution * vn[idx], Impulses.zeros(len(idx)), iterations,
+                           jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
+        scale = _keep_energy(model, wave, before, v, w)
+        keys = c.keys() if keys is None else keys
+        events.add(now, c.subset(idx), keys[idx], imp.normal * scale)
+        waves += 1
+    if waves:
+        state.body[:, V] = v[:-1]
+        state.body[:, W] = w[:-1]
+    return waves
+
+
+def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactRows,
+                    allowance: np.ndarray, events: EventLog, now: float, *,
+                    jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
+    """Stop every contact still closing faster than its ``allowance`` (e = 0), solved over the island
+    of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
+
+    After ``in_waves`` these are the approaches slower than the restitution threshold, and whatever
+    still arrives after MAX_WAVES waves. Inelastic impacts never add energy (checked as for a wave).
     """
     if len(c) == 0:
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
-    ra, rb = rows.arm_a, rows.arm_b
-    va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
-    rel = va + np.cross(wa, ra) - vb - np.cross(wb, rb)
-    if rows.moving:  # relative to a moving plane's surface
-        rel -= rows.surface
-    vn = np.einsum("ij,ij->i", rel, c.normal)
+    vn = normal_speeds(c, rows, v, w)
+    seeds = vn < -(allowance + APPROACH_SPEED)
+    if not seeds.any():
+        return
+    near = _island(model, c, seeds)
+    island = rows.subset(near)
+    before = _velocities(island, v, w)
+    imp = solver.solve(island, v, w, -allowance[near], Impulses.zeros(len(island)), model.solver_iterations,
+                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
+    scale = _keep_energy(model, island, before, v, w)
+    state.body[:, V] = v[:-1]
+    state.body[:, W] = w[:-1]
+    hit = c.subset(near)
+    events.add(now, hit, hit.keys(), imp.normal * scale)
+
+
+def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
+           allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
+           seeds_among: np.ndarray | None = None, jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
+    """The crowded step's bounce (until it calls ``in_waves``): the contacts that arrive bounce
+    together with their whole island, each from the approach speed it had before any of them did.
+
+    This is the rule that moves a touching cradle on as one block; the split step no longer uses it.
+    ``allowance`` is as in ``in_waves``. With ``arrivals_only`` only arrivals faster than the threshold
+    start an island; otherwise any approach does (and the slow ones in it just stop). ``seeds_among``,
+    when given, is where islands may start (other contacts only join them).
+    """
+    if len(c) == 0:
+        return
+    v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
+    vn = np.einsum("ij,ij->i", _relative_velocity(c, rows, v, w), c.normal)
     approaching = vn < -(allowance + APPROACH_SPEED)
     arriving = approaching & (-vn > threshold)
     seeds = arriving if arrivals_only else approaching
@@ -52,15 +152,7 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
         seeds = seeds & seeds_among
     if not seeds.any():
         return
-    # The island around the impacts: contacts within BOUNCE_HOPS balls of a seed.
-    n = model.spheres.count
-    involved = np.zeros(n + 1, bool)
-    near = seeds
-    for _ in range(BOUNCE_HOPS):
-        involved[c.a[near]] = True
-        involved[c.b[near]] = True
-        involved[n] = False
-        near = involved[c.a] | involved[c.b]
+    near = _island(model, c, seeds)
     island = rows.subset(near)
     target = np.where(arriving[near], -island.restitution * vn[near], -allowance[near])
     imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations,
@@ -70,3 +162,62 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
     body[:, W] = w[:-1]
     hit = c.subset(near)
     events.add(now, hit, hit.keys(), imp.normal)
+
+
+def _relative_velocity(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Each contact point's velocity of a relative to b (to a moving plane's surface), (K, 3)."""
+    va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
+    rel = va + np.cross(wa, rows.arm_a) - vb - np.cross(wb, rows.arm_b)
+    if rows.moving:
+        rel -= rows.surface
+    return rel
+
+
+def _island(model: Model, c: ContactPoints, seeds: np.ndarray) -> np.ndarray:
+    """The contacts within BOUNCE_HOPS balls of the ``seeds`` (a mask over ``c``)."""
+    n = model.spheres.count
+    involved = np.zeros(n + 1, bool)
+    near = seeds
+    for _ in range(BOUNCE_HOPS):
+        involved[c.a[near]] = True
+        involved[c.b[near]] = True
+        involved[n] = False
+        near = involved[c.a] | involved[c.b]
+    return near
+
+
+def _velocities(rows: ContactRows, v: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The balls the contacts ``rows`` touch (the static row left out) and their velocities now."""
+    balls = np.unique(np.concatenate((rows.a, rows.b)))
+    balls = balls[balls != rows.static]
+    return balls, v[balls], w[balls]
+
+
+def _keep_energy(model: Model, rows: ContactRows, before: tuple[np.ndarray, ...], v: np.ndarray,
+                 w: np.ndarray) -> float:  # fmt: skip
+    """Make sure the impulses just applied to the balls of ``rows`` added no kinetic energy, and return
+    the factor they were scaled by (1 when they added none).
+
+    With Δ the velocity change, K(s) = K₀ + s·B + ½·s²·A (B = Σ m·v₀·Δv + I·ω₀·Δω, A = Σ m·Δv² + I·Δω²).
+    If K(1) > K₀, the impulses are scaled by s = −2B/A (0 if B ≥ 0), where K(s) = K₀: equal and opposite
+    impulses stay so, and momentum is kept. A moving plane may give energy (a paddle): not checked then.
+    """
+    balls, v0, w0 = before
+    if rows.moving or len(balls) == 0:
+        return 1.0
+    dv, dw = v[balls] - v0, w[balls] - w0
+    mass = model.spheres.mass[balls]
+    inertia = 1.0 / model.spheres.inv_inertia[balls]
+
+    def dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return x[:, 0] * y[:, 0] + x[:, 1] * y[:, 1] + x[:, 2] * y[:, 2]
+
+    # exact sums (math.fsum): the same bits on every CPU
+    b = math.fsum(mass * dot(v0, dv)) + math.fsum(inertia * dot(w0, dw))
+    a = math.fsum(mass * dot(dv, dv)) + math.fsum(inertia * dot(dw, dw))
+    if b + 0.5 * a <= 0.0 or a == 0.0:
+        return 1.0
+    s = max(0.0, -2.0 * b / a)
+    v[balls] = v0 + s * dv
+    w[balls] = w0 + s * dw
+    return s

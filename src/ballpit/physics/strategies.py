@@ -132,9 +132,9 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         with prof.stage("penetration"):
             penetration.remove_penetration(model, state, touching, batch)
         closing = np.zeros(len(touching))  # touching contacts may not close at all: allowance and target
-        with prof.stage("impacts"):
-            impacts.bounce(model, state, touching, batch, step.threshold, closing, step.events, now,
-                           arrivals_only=False)  # fmt: skip
+        with prof.stage("impacts"):  # arrivals bounce in waves; then slower approaches stop
+            impacts.in_waves(model, state, touching, batch, step.threshold, closing, step.events, now)
+            impacts.stop_approaches(model, state, touching, batch, closing, step.events, now)
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, step.forces)
         with prof.stage("resting solve"):

@@ -1,0 +1,176 @@
+"""Touching balls struck together (impacts in waves) against the closed forms: Newton's cradle with no
+gaps, the Galilean cannon, a ball struck from two sides at once, a touching line on a floor, and what
+happens at the bound on the number of waves."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.physics import impacts, narrowphase, rows
+from ballpit.physics.contacts import EventLog
+from ballpit.physics.forces import free_acceleration
+
+G = 9.81
+R = 0.1  # m, the cradle's balls
+STEPS = [1 / 240, 1 / 60]
+
+
+def momentum(world: ballpit.World) -> np.ndarray:
+    return (world.spheres.masses[:, None] * world.spheres.velocities).sum(axis=0)
+
+
+def touching_cradle(world: ballpit.World, strikers: int, speed: float, y: float = 0.0) -> list:
+    """A row of five touching balls at x = 0 … 0.8, and ``strikers`` touching balls moving at
+    ``speed`` towards it, the first of them 0.05 m away; the balls are numbered left to right."""
+    first = -2 * R - 0.05
+    hit = [
+        world.add_sphere(position=(first - 2 * R * k, y, 0), radius=R, velocity=(speed, 0, 0), friction=0.0)
+        for k in reversed(range(strikers))
+    ]
+    row = [world.add_sphere(position=(2 * R * i, y, 0), radius=R, friction=0.0) for i in range(5)]
+    return hit + row  # left to right, in the order added
+
+
+@pytest.mark.parametrize("dt", STEPS)
+@pytest.mark.parametrize("strikers", [1, 2])
+def test_a_touching_cradle_struck_by_n_balls_sends_off_the_last_n_at_the_strikers_speed(strikers, dt):
+    world = ballpit.World(gravity=(0, 0, 0), integrator="rk4")
+    u = 1.0
+    balls = touching_cradle(world, strikers, u)
+    energy, p = world.kinetic_energy(), momentum(world)
+    for _ in range(round(0.3 / dt)):
+        world.step(dt)
+    speeds = world.spheres.velocities[:, 0]
+    assert speeds[-strikers:] == pytest.approx([u] * strikers, rel=0.02), speeds
+    assert np.abs(world.spheres.velocities[:-strikers]).max() < 0.02 * u, speeds
+    assert world.kinetic_energy() == pytest.approx(energy, rel=1e-3)
+    assert momentum(world) == pytest.approx(p, abs=1e-12)
+    assert len(balls) == 5 + strikers
+
+
+def cannon_apex(big: float, small: float, drop: float, big_r: float, small_r: float) -> float:
+    """The small ball's highest centre: it leaves the top of the big one (centre 2·R + r up) when
+    the big ball, landing at v = √(2·g·h) and bounced back (e = 1), meets it still falling at v:
+    u = (3M − m)/(M + m)·v, and rises u²/(2g) from there."""
+    v = math.sqrt(2 * G * drop)
+    u = (3 * big - small) / (big + small) * v
+    return 2 * big_r + small_r + u * u / (2 * G)
+
+
+@pytest.mark.parametrize("dt", STEPS)
+def test_the_galilean_cannon_throws_the_small_ball_to_the_closed_form_height(dt):
+    # 1 kg resting on 10 kg, dropped 1 m onto the floor, everything elastic: 7.65 m, not the 2.1 m
+    # the two reached when solved together.
+    M, m, big_r, small_r, h = 10.0, 1.0, 0.3, 0.1, 1.0
+    world = ballpit.World(integrator="rk4")
+    world.add_plane(restitution=1.0, friction=0.0)
+    world.add_sphere(position=(0, big_r + h, 0), radius=big_r, mass=M, friction=0.0)
+    top = world.add_sphere(position=(0, 2 * big_r + small_r + h, 0), radius=small_r, mass=m, friction=0.0)
+    highest = 0.0
+    for _ in range(round(2.5 / dt)):
+        world.step(dt)
+        highest = max(highest, float(top.position[1]))
+    assert highest == pytest.approx(cannon_apex(M, m, h, big_r, small_r), rel=0.02)
+    assert highest > 7.0
+
+
+@pytest.mark.parametrize(
+    ("left", "right", "expected"), [(1.0, -1.0, (-1.0, 0.0, 1.0)), (2.0, -1.0, (-4 / 3, 2 / 3, 5 / 3))]
+)
+def test_a_ball_struck_from_both_sides_at_once_takes_both_impacts_together(left, right, expected):
+    # Both contacts arrive in the same wave and are solved together: each leaves at its approach
+    # speed (e = 1), with momentum kept: equal balls at 2 and −1 m/s on a ball at rest leave at
+    # −4/3, 2/3 and 5/3 m/s.
+    world = ballpit.World(gravity=(0, 0, 0))
+    a = world.add_sphere(position=(-2 * R, 0, 0), radius=R, velocity=(left, 0, 0), friction=0.0)
+    b = world.add_sphere(position=(0, 0, 0), radius=R, friction=0.0)
+    c = world.add_sphere(position=(2 * R, 0, 0), radius=R, velocity=(right, 0, 0), friction=0.0)
+    energy = world.kinetic_energy()
+    world.step(1 / 240)
+    got = [a.velocity[0], b.velocity[0], c.velocity[0]]
+    assert got == pytest.approx(list(expected), abs=1e-9)
+    assert world.kinetic_energy() == pytest.approx(energy, rel=1e-9)
+
+
+@pytest.mark.parametrize("dt", STEPS)
+def test_a_touching_line_resting_on_a_floor_under_gravity_keeps_momentum_and_energy(dt):
+    # Five balls resting on a frictionless floor (resting contacts that must take no part in the
+    # impact), struck along the line: the striker stops, the last ball leaves at its speed, and the
+    # horizontal momentum and the total energy are kept.
+    world = ballpit.World(integrator="rk4")
+    world.add_plane(restitution=0.5, friction=0.0)
+    balls = touching_cradle(world, 1, 1.5, y=R)
+    for _ in range(10):  # let the resting contacts settle in first
+        world.step(dt)
+    px, energy = momentum(world)[0], world.kinetic_energy() + world.potential_energy()
+    for _ in range(round(0.3 / dt)):
+        world.step(dt)
+    v = world.spheres.velocities
+    assert v[-1, 0] == pytest.approx(1.5, rel=0.02)
+    assert np.abs(v[:-1]).max() < 0.02 * 1.5
+    assert momentum(world)[0] == pytest.approx(px, rel=1e-9)
+    assert world.kinetic_energy() + world.potential_energy() == pytest.approx(energy, rel=1e-3)
+    assert all(b.position[1] == pytest.approx(R, abs=1e-6) for b in balls)
+
+
+def test_a_line_longer_than_the_wave_bound_stops_the_rest_inelastically():
+    # One wave per ball: after MAX_WAVES the ball holding the impulse is stopped against the rest
+    # (e = 0), which keeps momentum and loses energy, never gains it.
+    n = impacts.MAX_WAVES + 8
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_spheres([(2 * R * i, 0, 0) for i in range(n)], radius=R, friction=0.0)
+    world.spheres[0].velocity = (1.0, 0, 0)
+    energy, p = world.kinetic_energy(), momentum(world)
+    world.step(1 / 240)
+    v = world.spheres.velocities[:, 0]
+    assert np.abs(v[: impacts.MAX_WAVES]).max() < 1e-12, "the waves passed the impulse that far"
+    assert v[impacts.MAX_WAVES] < 0.5, "then it was shared out inelastically"
+    assert world.kinetic_energy() < energy
+    assert momentum(world) == pytest.approx(p, abs=1e-12)
+
+
+def test_random_touching_clusters_struck_at_random_never_gain_energy():
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        world = ballpit.World(gravity=(0, 0, 0))
+        centres = [np.zeros(3)]
+        while len(centres) < 12:  # each ball touching one already placed
+            d = rng.normal(size=3)
+            centres.append(centres[rng.integers(len(centres))] + 2 * R * d / np.linalg.norm(d))
+        x = np.array(centres)
+        far = np.linalg.norm(x[:, None] - x[None], axis=2) + np.eye(len(x)) >= 2 * R - 1e-9
+        if not far.all():
+            continue
+        world.add_spheres(x, radius=R, velocity=rng.normal(0, 1.0, x.shape), friction=rng.uniform(0, 0.5),
+                          restitution=rng.uniform(0.5, 1.0))  # fmt: skip
+        energy, p = world.kinetic_energy(), momentum(world)
+        world.step(1 / 240)
+        assert world.kinetic_energy() <= energy * (1 + 1e-12)
+        assert momentum(world) == pytest.approx(p, abs=1e-9)
+
+
+@pytest.mark.parametrize("gap", [0.0, 1e-3])
+def test_waves_with_the_crowded_steps_allowances_and_all_at_once_solves_pass_the_cradle_impulse(gap):
+    # How a crowded step calls the rule: every contact within reach, speculative ones allowed to close
+    # by gap/dt, and every solve by Jacobi sweeps (jacobi_from=0). The line still passes the impulse on.
+    dt = 1 / 240
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_spheres([((2 * R + gap) * i, 0, 0) for i in range(6)], radius=R, friction=0.0)
+    world.spheres[0].velocity = (2 * gap / dt + 1.0, 0, 0)  # arrives within the step
+    model, state = world.model, world.state
+    accel, _ = free_acceleration(state.body, model.forces())
+    pairs = world._pairs.for_step(model, state, accel, dt)
+    c = narrowphase.contact_points(model, state, pairs)
+    allowance = np.where(c.gap < 1e-5, 0.0, c.gap / dt)
+    batch = rows.contact_rows(model, state, c)
+    p = momentum(world)
+    waves = impacts.in_waves(model, state, c, batch, 0.0, allowance, EventLog(), 0.0, jacobi_from=0)
+    v = world.spheres.velocities[:, 0]
+    assert waves == 5
+    assert v[-1] == pytest.approx(2 * gap / dt + 1.0, rel=1e-12)
+    assert np.abs(v[:-1]).max() < 1e-12
+    assert momentum(world) == pytest.approx(p, abs=1e-12)
