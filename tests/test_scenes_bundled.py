@@ -163,6 +163,8 @@ def test_integrators_agree_at_first_then_part_ways(tmp_path):
     # all three lose energy to the drag only: the walls and balls are perfectly elastic and smooth
     speeds = {k: np.linalg.norm(r[:, :, 5:8], axis=2) for k, r in runs.items()}
     assert all((s[five] ** 2).sum() < (s[0] ** 2).sum() for s in speeds.values())
+
+
 def test_touching_cradle_sends_off_two_balls_when_two_strike(tmp_path):
     """Two touching strikers at 2 m/s hit five touching balls: the strikers and the three first balls
     stop, the last two leave at 2 m/s (impacts in waves), and energy is kept."""
