@@ -217,6 +217,11 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         jacobi.separate(c.a, c.b, c.normal, s, rows.inv_mass_a, rows.inv_mass_b, pos, 2 * penetration.SWEEPS)
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
+        moved = new - body[:, X]
+        ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
+        d = ma - mb
+        np.minimum(least, s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
+                   out=least)  # fmt: skip
         body[:, X] = new
     return Frame(balls, total, least, farthest, largest, lo, hi)
 

@@ -1,0 +1,79 @@
+"""The crowded step as soft substeps (softstep.py): its public setting, and the promises it keeps
+whatever the speed: nothing leaves a closed box or passes through a plane, overlaps stay shallow, a
+closed elastic box never gains energy."""
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.scene import read_scene
+from ballpit.scene.fields import SceneError
+
+G = 9.81
+
+
+def closed_box(world: ballpit.World, half: float, restitution: float = 1.0, friction: float = 0.0) -> None:
+    """Six infinite walls facing in, ``half`` from the origin."""
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            normal = np.zeros(3)
+            normal[axis] = sign
+            world.add_plane(
+                position=-half * normal, normal=normal, restitution=restitution, friction=friction
+            )
+
+
+def test_substeps_default_to_one_and_refuse_what_is_not_a_whole_number_of_at_least_one():
+    world = ballpit.World()
+    assert world.substeps == 1
+    assert ballpit.World(substeps=4).substeps == 4
+    for bad in (0, -1, 2.5, "4", True):
+        with pytest.raises(ValueError, match="substeps"):
+            world.substeps = bad
+
+
+def test_snapshots_and_copies_keep_the_substeps():
+    world = ballpit.World(substeps=3)
+    snap = world.snapshot()
+    world.substeps = 1
+    assert world.copy().substeps == 1
+    world.restore(snap)
+    assert world.substeps == 3
+
+
+def test_a_scene_file_sets_the_substeps_and_a_bad_value_names_the_key(tmp_path):
+    good = tmp_path / "good.toml"
+    good.write_text("[world]\nsubsteps = 4\n")
+    assert read_scene(good).world.substeps == 4
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[world]\nsubsteps = 0\n")
+    with pytest.raises(SceneError, match="substeps"):
+        read_scene(bad)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_ten_balls_at_1000_m_per_s_in_a_closed_box_never_leave_it(seed):
+    # 1,000 m/s is 4 m a step at 1/240 s in a 1 m box: several bounces inside one step. Every step is
+    # crowded (crowd_limit 0); the soft step cannot hold that, so it is split at the impacts.
+    rng = np.random.default_rng(seed)
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.crowd_limit = 0
+    closed_box(world, 0.5)
+    r = 0.05
+    world.add_spheres(rng.uniform(-0.4, 0.4, (10, 3)) * [1, 1, 1], radius=r,
+                      velocity=rng.normal(0, 1, (10, 3)) * 1000 / np.sqrt(3))  # fmt: skip
+    for _ in range(6):
+        world.step(1 / 240)
+        assert (np.abs(world.spheres.positions) <= 0.5 - r + 1e-6).all()
+
+
+def test_a_hot_gas_at_250_m_per_s_stays_in_its_closed_box():
+    world = read_scene("scenes/gas.toml").world
+    scale = 250.0 / np.linalg.norm(world.spheres.velocities, axis=1).mean()
+    for ball in world.spheres:
+        ball.velocity = ball.velocity * scale
+    half = 1.5
+    r = world.spheres.radii[:, None]
+    for _ in range(2):
+        world.step(1 / 240)
+        assert (np.abs(world.spheres.positions) <= half - r + 1e-6).all()
