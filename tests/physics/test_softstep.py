@@ -77,3 +77,23 @@ def test_a_hot_gas_at_250_m_per_s_stays_in_its_closed_box():
     for _ in range(2):
         world.step(1 / 240)
         assert (np.abs(world.spheres.positions) <= half - r + 1e-6).all()
+
+
+@pytest.mark.parametrize("floor", ["level", "slope", "moving"])
+def test_sixty_coincident_balls_above_an_open_floor_never_go_through_it_nor_sink_in(floor):
+    # All 60 created at one point 1 m up: they are pushed apart (at most MAX_PUSH) and land in a heap;
+    # no ball's centre comes nearer the floor than 95 % of its radius, on a level floor, a slope or a
+    # floor rising at 0.2 m/s.
+    world = ballpit.World()
+    if floor == "level":
+        plane = world.add_plane()
+    elif floor == "slope":
+        plane = world.add_plane(rotation=(0, 0, 20))
+    else:
+        plane = world.add_plane(velocity=(0, 0.2, 0))
+    r = 0.1
+    world.add_spheres(np.tile([0.0, 1.0, 0.0], (60, 1)), radius=r, restitution=0.5)
+    for _ in range(480):
+        world.step(1 / 240)
+        height = (world.spheres.positions - plane.position) @ plane.normal
+        assert height.min() >= 0.95 * r

@@ -70,6 +70,7 @@ class _Rows(jacobi._Contacts):
         self.iia, self.iib = rows.inv_inertia_a, rows.inv_inertia_b
         ra, rb = -self.minus_ra, -self.minus_rb
         self.ra2, self.rb2 = ra * ra, rb * rb
+        self.whole = self.ima + self.imb  # 1/m_n of the unsplit balls
 
     def share_among(self, active: np.ndarray) -> None:
         """Split each ball's mass among its ``active`` contacts (at least one share each)."""
@@ -119,12 +120,11 @@ class Frame:
     hi: np.ndarray
 
 
-def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, threshold: float,
-          warm) -> Frame:  # fmt: skip
-    """Advance the balls the contacts ``c`` touch by ``dt`` in ``model.substeps`` substeps (their
+def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, threshold: float, warm,
+          substeps: int) -> Frame:  # fmt: skip
+    """Advance the balls the contacts ``c`` touch by ``dt`` in ``substeps`` substeps (their
     states change in place; planes and other balls do not move here). ``warm`` (resting.WarmStart) gives
     and keeps the impulses; ``threshold`` is the restitution threshold (m/s)."""
-    substeps = model.substeps
     h = dt / substeps
     n_balls = model.spheres.count
     rows = contact_rows(model, state, c)
@@ -211,10 +211,15 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     body[idx, W] = vw[3:, live].T
     body[idx, Q] = q
     # what the substeps left overlapping is moved apart by positions alone (penetration.py)
+    # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
+    # heap of balls created at one point is pushed apart, never launched by a jump of positions)
     s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
-    if (s < -penetration.OVERLAP_TOLERANCE).any():
+    made = s - np.minimum(c.gap + MAX_PUSH * dt, 0.0)
+    if (made < -penetration.OVERLAP_TOLERANCE).any():
         pos = with_static(body[:, X])
-        jacobi.separate(c.a, c.b, c.normal, s, rows.inv_mass_a, rows.inv_mass_b, pos, 2 * penetration.SWEEPS)
+        jacobi.separate(
+            c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, 2 * penetration.SWEEPS
+        )
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
@@ -223,7 +228,37 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         np.minimum(least, s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
                    out=least)  # fmt: skip
         body[:, X] = new
+    _out_of_planes(model, state, c, rows, least, x0, idx, dt)
     return Frame(balls, total, least, farthest, largest, lo, hi)
+
+
+def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.ndarray, x0: np.ndarray,
+                   idx: np.ndarray, dt: float) -> None:  # fmt: skip
+    """Planes win: a ball the frame left deeper in a plane than it started is moved back out along the
+    plane's normal (positions only, paying for the lift as penetration.py does). Shared among all of a
+    ball's contacts, the masses split many ways, the solve cannot always hold a crowd off a floor."""
+    on = np.flatnonzero(rows.b == model.spheres.count)
+    if on.size == 0:
+        return
+    body = state.body
+    start = np.zeros((len(body), 3))
+    start[idx] = x0[:, : len(idx)].T
+    a, nrm = c.a[on], c.normal[on]
+    d = body[a, 0:3] - start[a]
+    s = c.gap[on] + d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2]
+    if rows.moving:  # the plane's surface moves on over the frame too
+        u = rows.surface[on]
+        s -= (u[:, 0] * nrm[:, 0] + u[:, 1] * nrm[:, 1] + u[:, 2] * nrm[:, 2]) * dt
+    deficit = np.maximum(np.minimum(c.gap[on], 0.0) - s, 0.0)
+    if not (deficit > penetration.OVERLAP_TOLERANCE).any():
+        return
+    new = body[:, X].copy()
+    lift = np.zeros((len(body), 3))
+    np.add.at(lift, a, deficit[:, None] * nrm)
+    new += lift
+    penetration.pay_for_lift(model, state, body[:, X], new)
+    body[:, X] = new
+    least[on] = np.minimum(least[on], s + deficit)
 
 
 def restitution_pass(rows: ContactRows, k: jacobi._Contacts, vw: np.ndarray, normal: np.ndarray,
@@ -349,6 +384,9 @@ def _sweeps(k: jacobi._Contacts, vw: np.ndarray, push: np.ndarray, normal: np.nd
     resistance (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses."""
     kc, n = k.k, k.n
     m_n = k.m_n * scale
+    # The spring's give, −keep·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
+    # keep·P/m_whole), so a ball's share of a crowd does not make its contacts softer.
+    keep = keep * k.m_n * k.whole
     for sweep in range(sweeps):
         if sweep < sweeps - 1:  # normal impulses alone: only the linear velocities matter
             vn = _normal_speed(k, vw)

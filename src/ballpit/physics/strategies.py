@@ -31,6 +31,8 @@ from .state import State, V, W, X, with_static
 # Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
 # meeting makes the step crowded (a pile, not a textbook scene).
 CROWD_PAIRS = 256
+# A contact overlapping by more than this fraction of its ball's radius makes the step crowded.
+CROWD_OVERLAP = 0.02
 # The pairs of a crowded step are those within this many times the distance they could close.
 SPECULATIVE_REACH = 2.0
 # In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
@@ -39,6 +41,9 @@ UNGUARDED_OVERLAP = 0.05
 # A crowded step is taken as soft substeps only while no ball it moves travels more than this fraction
 # of its radius in one substep (before, by its speed and acceleration; after, as it moved).
 SUBSTEP_TRAVEL = 1.0
+# A frame the soft step cannot hold is tried again with twice the substeps, at most this many times,
+# before the step is split at impacts.
+RETRIES = 2
 # ... and while no pair overlaps by more than this fraction of the smaller radius.
 DEEP_OVERLAP = 0.25
 # A step is split at most this many times; past it the rest of the step is finished conservatively:
@@ -91,7 +96,10 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndar
     # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
     # soft step it landed in, not alternately in the two
     if meetings <= (0 if many else model.crowd_limit) and not (many and (c.gap < CONTACT_SLOP).any()):
-        return None
+        # balls overlapping deeply (created at one point, or left so by a crowd) are pushed apart
+        # by the soft step, whose planes hold, not jumped apart by positions
+        if model.crowd_limit == np.inf or not (c.gap < -CROWD_OVERLAP * model.spheres.radius[c.a]).any():
+            return None
     return speculative_reach(step, c, accel, dv, da)
 
 
@@ -195,37 +203,57 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
     of ``contacts`` where ``solved`` holds; True when it was taken so.
 
     The soft step keeps the walls only while every ball it moves travels less than SUBSTEP_TRAVEL of
-    its radius per substep, and while nothing it did not foresee happens. So a frame is split at
-    impacts instead (``split_at_impacts``, which passes through nothing) when some ball could travel
-    farther before it starts, and it is undone and split at impacts when, after it:
+    its radius per substep, and while nothing it did not foresee happens. A frame is tried with twice
+    the substeps (at most RETRIES times) when some ball could travel farther before it starts, or
+    when it is undone after it because:
 
     - a ball moved farther than that in a substep, or left the box its pairs were found from (then a
       pair the broad phase never saw could have met);
     - a solved contact overlapped deeper than DEEP_OVERLAP of the smaller radius at any substep's end;
     - a pair left out of the contacts that could have met overlaps that deep at the end.
+
+    When no try holds, the step is split at impacts instead (``split_at_impacts``, which passes
+    through nothing, however fast).
     """
     model, state, dt, now = step.model, step.state, step.dt, step.state.time
     free, _ = accel
+    solved = solved | (contacts.kind == SPHERE_PLANE)  # every kept pair with a plane: planes hold
     c = contacts.subset(solved)
-    n = model.spheres.count
     radius = np.append(model.spheres.radius, np.inf)
-    h = dt / model.substeps
     v = with_static(state.body[:, V])
     acc = with_static(free)
-    travel = np.sqrt(np.einsum("ij,ij->i", v, v)) * h + np.sqrt(np.einsum("ij,ij->i", acc, acc)) * h * h
-    fast = travel > SUBSTEP_TRAVEL * radius
-    if fast[c.a].any() or fast[c.b].any():
+    speed, pull = np.sqrt(np.einsum("ij,ij->i", v, v)), np.sqrt(np.einsum("ij,ij->i", acc, acc))
+    for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
+        h = dt / substeps
+        fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
+        if fast[c.a].any() or fast[c.b].any():
+            step.doubt = "a ball could travel farther than SUBSTEP_TRAVEL radii in a substep"
+            continue
+        frame = _soft_frame(step, contacts, solved, c, accel, substeps)
+        if frame is not None:
+            break
+    else:
         return False
+    step.events.add(now, c, c.keys(), frame.impulse)
+    step.profile.intervals += 1
+    return True
+
+
+def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
+                accel: tuple[np.ndarray, np.ndarray], substeps: int) -> softstep.Frame | None:  # fmt: skip
+    """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone,
+    the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted."""
+    model, state, dt = step.model, step.state, step.dt
+    n = model.spheres.count
     body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
     warm_before = (step.warm.keys, step.warm.forces)
     kept_before = step.pairs.kept
     with step.profile.stage("soft step"):
-        frame = softstep.frame(model, state, c, step.forces, dt, step.threshold, step.warm)
+        frame = softstep.frame(model, state, c, step.forces, dt, step.threshold, step.warm, substeps)
         balls = frame.balls[frame.balls < n]
         others = np.ones(n, bool)
         others[balls] = False
-        energy_held = not model.moving_planes()
-        if energy_held:
+        if not model.moving_planes():  # then nothing does work on the balls but gravity
             softstep.hold_energy(model, state, body_before, balls)
     if others.any():  # balls touching nothing this frame fly on the world's integrator
         with step.profile.stage("integrate"):
@@ -235,20 +263,18 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
             state.body[others] = rows
     moving_planes.advance(model, state, dt)
     with step.profile.stage("time of impact"):
-        step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before)
-    if step.doubt is not None:  # undo it all and split the step at impacts instead
-        state.body[:] = body_before
-        state.planes = planes_before
-        step.warm.keys, step.warm.forces = warm_before
-        step.pairs.kept = kept_before
-        return False
-    step.events.add(now, c, c.keys(), frame.impulse)
-    step.profile.intervals += 1
-    return True
+        step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before, substeps)
+    if step.doubt is None:
+        return frame
+    state.body[:] = body_before  # undo it all
+    state.planes = planes_before
+    step.warm.keys, step.warm.forces = warm_before
+    step.pairs.kept = kept_before
+    return None
 
 
 def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
-                frame: softstep.Frame, before: np.ndarray) -> str | None:  # fmt: skip
+                frame: softstep.Frame, before: np.ndarray, substeps: int) -> str | None:  # fmt: skip
     """Why a soft frame cannot be trusted (see ``crowded_step``), or None when it kept its promises.
 
     A ball that left the box its pairs were found from may have met a body the broad phase never
@@ -263,8 +289,8 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     if (frame.largest_move[cols] > SUBSTEP_TRAVEL * r).any():
         return "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
-    if (frame.least_separation < -DEEP_OVERLAP * smaller).any():
-        return "a contact overlapped deeper than DEEP_OVERLAP"
+    if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
+        return "a contact overlapped deeper than DEEP_OVERLAP (more than it did)"
     # how far each ball got from where it started (the others flew straight)
     far = np.zeros(n + 1)
     moved = state.body[:, X] - before[:, X]
@@ -289,9 +315,8 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         out = contacts.subset(~solved)
         near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
         out = out.subset(near)
-        if len(out) and model.moving_planes():
-            return "a pair left out may have met a moving plane"
-        out.gap = _gap_from(out, before, model, state)
+        start = np.minimum(out.gap, 0.0)
+        out.gap = _gap_from(out, before, model, state) - start
     if len(out) == 0:
         return None
     on_plane = out.kind == SPHERE_PLANE
