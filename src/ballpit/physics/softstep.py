@@ -51,6 +51,9 @@ from .state import Q, V, W, X, with_static
 CONTACT_HERTZ = 60.0
 DAMPING_RATIO = 10.0
 MAX_PUSH = 3.0
+# Overlaps up to this fraction of the smaller radius are left to the soft spring (which holds a
+# resting pile with some give); only deeper ones are moved apart by positions after the substeps.
+SLOP = 0.01
 # Jacobi sweeps per substep: with the bias, then without it (relax). Friction and rolling resistance
 # are updated in the last sweep of each; the others update the normal impulses alone.
 SOLVE_SWEEPS = 4
@@ -214,7 +217,12 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
     # heap of balls created at one point is pushed apart, never launched by a jump of positions)
     s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
-    made = s - np.minimum(c.gap + MAX_PUSH * dt, 0.0)
+    slop = SLOP * np.where(
+        on_plane,
+        model.spheres.radius[c.a],
+        np.minimum(*(model.spheres.radius[e] for e in (c.a, np.minimum(c.b, n_balls - 1)))),
+    )
+    made = s - np.minimum(c.gap + MAX_PUSH * dt, -slop)
     if (made < -penetration.OVERLAP_TOLERANCE).any():
         pos = with_static(body[:, X])
         jacobi.separate(
@@ -249,7 +257,7 @@ def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.
     if rows.moving:  # the plane's surface moves on over the frame too
         u = rows.surface[on]
         s -= (u[:, 0] * nrm[:, 0] + u[:, 1] * nrm[:, 1] + u[:, 2] * nrm[:, 2]) * dt
-    deficit = np.maximum(np.minimum(c.gap[on], 0.0) - s, 0.0)
+    deficit = np.maximum(np.minimum(c.gap[on], -SLOP * model.spheres.radius[a]) - s, 0.0)
     if not (deficit > penetration.OVERLAP_TOLERANCE).any():
         return
     new = body[:, X].copy()
