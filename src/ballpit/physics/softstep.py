@@ -58,6 +58,8 @@ SLOP = 0.01
 # are updated in the last sweep of each; the others update the normal impulses alone.
 SOLVE_SWEEPS = 4
 RELAX_SWEEPS = 2
+# Jacobi sweeps that move apart, by positions, the overlaps deeper than SLOP the substeps left.
+SEPARATE_SWEEPS = 16
 # Jacobi sweeps of the restitution pass (normal impulses only).
 RESTITUTION_SWEEPS = 4
 
@@ -224,10 +226,10 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     )
     made = s - np.minimum(c.gap + MAX_PUSH * dt, -slop)
     if (made < -penetration.OVERLAP_TOLERANCE).any():
+        # those deeper than the slop go back to 0.8 of it, so they are not caught again next frame
+        made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -0.8 * slop), made)
         pos = with_static(body[:, X])
-        jacobi.separate(
-            c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, 2 * penetration.SWEEPS
-        )
+        jacobi.separate(c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, SEPARATE_SWEEPS)
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
