@@ -107,8 +107,9 @@ def test_a_settled_pile_rests_below_a_millimetre_per_second_without_creeping():
     world.add_plane(normal=(0, 1, 0), restitution=0.5, friction=0.5, rolling_friction=0.02)
     for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
         world.add_plane(position=np.multiply(normal, -0.3), normal=normal, restitution=0.5)
-    ix, iy, iz = np.meshgrid(np.arange(5), np.arange(4), np.arange(5), indexing="ij")
-    cells = np.stack((ix.ravel() - 2, iy.ravel(), iz.ravel() - 2), axis=1) * 0.11 + [0, 0.1, 0]
+    ix, iz = np.meshgrid(np.arange(5), np.arange(5), indexing="ij")
+    layer = np.column_stack(((ix.ravel() - 2) * 0.11, np.zeros(25), (iz.ravel() - 2) * 0.11))
+    cells = np.vstack([layer + [0, 0.1 + 0.11 * k, 0] for k in range(4)])
     world.add_spheres(cells + rng.uniform(-0.003, 0.003, (100, 3)), radius=0.05, restitution=0.5,
                       rolling_friction=0.02)  # fmt: skip
     for _ in range(720):

@@ -46,6 +46,7 @@ SUBSTEP_TRAVEL = 1.0
 RETRIES = 2
 # ... and while no pair overlaps by more than this fraction of the smaller radius.
 DEEP_OVERLAP = 0.25
+DEEPER = "a contact overlapped deeper than DEEP_OVERLAP (more than it did)"
 # A step is split at most this many times; past it the rest of the step is finished conservatively:
 # the balls that could meet anything stop where they are (see ``finish_conservatively``).
 MAX_INTERVALS = 1_000
@@ -229,7 +230,8 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
         if fast[c.a].any() or fast[c.b].any():
             step.doubt = "a ball could travel farther than SUBSTEP_TRAVEL radii in a substep"
             continue
-        frame = _soft_frame(step, contacts, solved, c, accel, substeps)
+        last = substeps == model.substeps << RETRIES
+        frame = _soft_frame(step, contacts, solved, c, accel, substeps, last)
         if frame is not None:
             break
     else:
@@ -240,9 +242,12 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
 
 
 def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
-                accel: tuple[np.ndarray, np.ndarray], substeps: int) -> softstep.Frame | None:  # fmt: skip
+                accel: tuple[np.ndarray, np.ndarray], substeps: int,
+                last: bool) -> softstep.Frame | None:  # fmt: skip
     """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone,
-    the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted."""
+    the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted. The ``last`` try is
+    kept when its only fault is a solved contact that overlapped deeper: that is no pass through
+    anything, and splitting a heap of overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
     body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
@@ -264,7 +269,7 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     moving_planes.advance(model, state, dt)
     with step.profile.stage("time of impact"):
         step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before, substeps)
-    if step.doubt is None:
+    if step.doubt is None or (last and step.doubt == DEEPER):
         return frame
     state.body[:] = body_before  # undo it all
     state.planes = planes_before
@@ -290,7 +295,7 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         return "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
     if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
-        return "a contact overlapped deeper than DEEP_OVERLAP (more than it did)"
+        return DEEPER
     # how far each ball got from where it started (the others flew straight)
     far = np.zeros(n + 1)
     moved = state.body[:, X] - before[:, X]
