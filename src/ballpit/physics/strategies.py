@@ -223,7 +223,8 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
     radius = np.append(model.spheres.radius, np.inf)
     v = with_static(state.body[:, V])
     acc = with_static(free)
-    speed, pull = np.sqrt(np.einsum("ij,ij->i", v, v)), np.sqrt(np.einsum("ij,ij->i", acc, acc))
+    speed = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
