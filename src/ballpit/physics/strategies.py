@@ -4,10 +4,12 @@
   Each interval finds the contacts, pushes overlapping balls apart, bounces the ones that arrive,
   solves the resting contacts for constant forces over the rest of the step, predicts the next
   impact and integrates to it. This is what gives e²·h apexes at 60 Hz and Newton's cradle.
-- ``whole_with_speculative_contacts``: when many pairs may meet within one step (a pile landing),
-  splitting it at each impact costs a pass over the world per impact. The step is taken whole instead
-  (P. Firth, "Speculative contacts", 2011; as in Box2D v3 and Bullet): every pair that could meet
-  joins the solves as a contact with a gap, which may close by at most that gap, v_n ≥ −gap/dt.
+- ``crowded_step``: when many pairs may meet within one step (a pile landing or resting), splitting
+  it at each impact costs a pass over the world per impact. The step is one frame of Box2D v3's soft
+  step instead (softstep.py): contacts measured once, with a speculative margin (P. Firth,
+  "Speculative contacts", 2011), then ``substeps`` soft-biased solves. Where it cannot keep the walls
+  (balls too fast for a substep, or something it did not foresee) it is retried with more substeps
+  and, failing that, split at impacts.
 
 ``crowded_contacts`` decides between them. Each strategy passes its targets to the stages explicitly.
 """
@@ -35,9 +37,6 @@ CROWD_PAIRS = 256
 CROWD_OVERLAP = 0.02
 # The pairs of a crowded step are those within this many times the distance they could close.
 SPECULATIVE_REACH = 2.0
-# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
-# fraction of the smaller radius cuts the step short at its impact.
-UNGUARDED_OVERLAP = 0.05
 # A crowded step is taken as soft substeps only while no ball it moves travels more than this fraction
 # of its radius in one substep (before, by its speed and acceleration; after, as it moved).
 SUBSTEP_TRAVEL = 1.0

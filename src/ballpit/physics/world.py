@@ -74,7 +74,7 @@ class World:
         self.restitution_threshold = restitution_threshold
         self.sleep = sleep
         self.substeps = substeps
-        self.crowded_steps = 0  # how many steps were taken whole, with speculative contacts
+        self.crowded_steps = 0  # how many steps were taken as soft substeps (crowded)
         self.profile = StepProfile()  # the last step's time per stage (profile.py)
         self._pairs = PairCache()
         self._warm = WarmStart()
@@ -291,7 +291,7 @@ class World:
         Stages: waking what was changed by hand (sleeping.py), the kept pairs (found again only when
         a path leaves its box), the narrow phase, waking the islands awake balls reach, the crowd
         test, then one of the two strategies (strategies.py): split the step at every impact, or take
-        a crowded step whole with speculative contacts; last, still islands fall asleep. ``profile``
+        a crowded step as soft substeps (softstep.py); last, still islands fall asleep. ``profile``
         then holds the step's time per stage.
         """
         dt = validation.number("dt", dt, positive=True)
