@@ -18,7 +18,6 @@ STAGES = (
     "penetration",
     "impacts",
     "resting solve",
-    "soft step",
     "time of impact",
     "integrate",
     "sleep",
