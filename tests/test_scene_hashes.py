@@ -63,17 +63,17 @@ SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SECONDS = 2.0
 RUN_SECONDS = {"pile10k": 0.7}  # the rest run SECONDS
 HASHES = {
-    "slopes": "TBD",
-    "cradle": "TBD",
-    "cradle_touching": "TBD",
-    "cannon": "TBD",
-    "billiards": "TBD",
-    "incline": "TBD",
-    "gas": "TBD",
-    "pile": "TBD",
-    "pile10k": "TBD",
-    "seesaw": "TBD",
-    "integrators": "TBD",
+    "slopes": "288f8ec12fba4e61f899da699c5d1fbf2016d987099ce406f78d90afb5fa127a",
+    "cradle": "4f893dd8f2d151d5883149cd93af3aaefba83ccc7d8289a6121a877faad1150d",
+    "cradle_touching": "5c2fe00e0740007f95b107236c28f3f5ae4e5196609bdbdfcb21393f11951a48",
+    "cannon": "222fd2e64e49534af044705ca7a0a923405d217bbc8d219bceb39d9459504df7",
+    "billiards": "158e11e8d434299e1a279611bcd46948e686c1814f6ab8fa33e5034854d7726e",
+    "incline": "2b0d33dc38bf229efc8cbcfd5c7862c6d75a650fd97eb0636de4ed0a47122f78",
+    "gas": "64b4d2c6b9d786255f02c7b31e95b706a6819e82c0727e7fc589839952cfc7b4",
+    "pile": "d80abd852f1aa8407eeaf86923e4a15ae80d6c2527042c6b1063f6d4cc60c227",
+    "pile10k": "ba5007099e146f0ab336cbee6b270d0e68a5192331e726cb85da4735b32a06a7",
+    "seesaw": "1db6077f7dc856c99a595f58c9ce44355c5ad3d48cc8b26f371637280149cb93",
+    "integrators": "3e95d48e2c534676fff96764a4ee0ce8092b53735e85ecfd962d0e36f6f45f1b",
 }
 
 

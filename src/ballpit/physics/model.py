@@ -23,8 +23,8 @@ CROWD_LIMIT = 32
 # Projected Gauss–Seidel sweeps per solve.
 SOLVER_ITERATIONS = 10
 
-# Defaults of World.add_sphere/add_spheres/add_plane (design.md); the scene schema reads them from
-# those signatures, so this is their one home.
+# Defaults of World.add_sphere/add_spheres/add_plane (the README's Python API); the scene schema
+# reads them from those signatures, so this is their one home.
 BALL_RADIUS = 0.5  # m
 BALL_MASS = 1.0  # kg
 BALL_RESTITUTION = 1.0  # so a default ball bouncing off a plane shows exactly the plane's bounciness

@@ -1,6 +1,6 @@
 """Penetration removal: overlapping balls are moved apart, by positions only.
 
-No velocity is added, so removing an overlap never launches a ball (design.md), and the potential
+No velocity is added, so removing an overlap never launches a ball (docs/architecture.md), and the potential
 energy a separation adds against gravity is taken out of the moved balls' kinetic energy, so it never
 adds energy either. Each overlapping contact's linearised gap g = n·(x_a − x_b) − offset is driven to
 zero by a few Gauss–Seidel sweeps over the contact colours, each ball moved in proportion to its

@@ -2,8 +2,9 @@
 interval: both bodies' inverse masses and inertias, the lever arms, the mixed materials, and the
 colours that let contacts sharing no ball be solved together.
 
-Material mixing (design.md): restitution e = e_a·e_b, friction μ = sqrt(μ_a·μ_b), rolling friction
-ρ = sqrt(ρ_a·ρ_b). Balls are rows 0…N−1; row N is the static world (planes), with zero inverse mass.
+Material mixing (README, "Contact model"): restitution e = e_a·e_b, friction μ = sqrt(μ_a·μ_b),
+rolling friction ρ = sqrt(ρ_a·ρ_b). Balls are rows 0…N−1; row N is the static world (planes), with
+zero inverse mass (docs/architecture.md, "Conventions").
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Keys are named as in ``pyglet.window.key`` (``key.symbol_string(symbol)``: "X", 
 ...). + and − are read from the typed text instead (``TEXT_ACTIONS``): "+" is Shift+"=" on most layouts,
 and when Shift is let go first X reports the release as EQUAL, so pyglet still believes PLUS is held and
 swallows the next press; the text event arrives every time, from the main keys and the keypad alike.
-The table follows the "Viewer controls" section of design.md; ``HELP`` is the text of the F1 overlay
+The table follows the "Viewer controls" section of the README; ``HELP`` is the text of the F1 overlay
 and is built from the same bindings. The number keys come from the integrator registry
 (``physics/integrators.py``): one ``IntegratorAction`` per registered integrator, on its key.
 """
