@@ -88,7 +88,7 @@ def test_bench_help_says_its_whole_first_sentence(capsys):
         bench.main(["--help"])
     assert exc.value.code == 0
     help_text = " ".join(capsys.readouterr().out.split())
-    assert "a pile at rest, and the slopes demo." in help_text
+    assert "a pile at rest, and the slopes and see-saw demos." in help_text
 
 
 @pytest.mark.parametrize(
