@@ -3,7 +3,15 @@ conftest.py) is a ``window`` test without saying so; ``slow`` ones say so themse
 
 from __future__ import annotations
 
+import signal
+
 import pytest
+
+# A suite started in the background by a script (`make test &`, nohup) inherits SIGINT ignored, and so
+# would every process a test starts: the Ctrl+C tests need it delivered. A Python handler (unlike
+# SIG_IGN) goes back to the default in the children.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 WINDOW_FIXTURES = frozenset({"xvfb", "offscreen", "offscreen_session"})
 
