@@ -35,8 +35,9 @@ import numpy as np
 
 from ballpit.physics import broadphase, jacobi, narrowphase, rows, solver
 from ballpit.physics.contacts import ContactPoints
-from ballpit.physics.pairs import CONTACT_SLOP, KeptPairs, plane_pairs, plane_sides
+from ballpit.physics.pairs import KeptPairs, plane_pairs, plane_sides
 from ballpit.physics.resting import WarmStart
+from ballpit.physics.settings import CONTACT_SLOP
 from ballpit.physics.state import V, W, X, with_static
 from ballpit.scene import read_scene
 

@@ -41,22 +41,16 @@ from . import solver
 from .contacts import ContactPoints, EventLog
 from .model import Model
 from .rows import ContactRows
+from .settings import (
+    APPROACH_SPEED,
+    BOUNCE_HOPS,
+    BOUNCE_JACOBI_SWEEPS,
+    JACOBI_FROM,
+    MAX_WAVES,
+    WAVE_ITERATIONS,
+)
 from .solver import Impulses
 from .state import State, V, W, with_static
-
-# The most waves one impact sets off; what still arrives after them is stopped (e = 0). A touching
-# line needs one wave per ball.
-MAX_WAVES = 64
-# A wave is solved until no contact's speed changes by more than 1e-9 m/s in a sweep, or this many
-# sweeps (at least the world's solver_iterations): a ball struck from two sides needs about 15.
-WAVE_ITERATIONS = 50
-# The stop (and the crowded step's bounce) is solved over the contacts within this many balls of a
-# closing one.
-BOUNCE_HOPS = 3
-# A bounce is solved afresh (no warm start, nothing to hold at rest): Jacobi sweeps per iteration.
-BOUNCE_JACOBI_SWEEPS = 1
-# Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
-APPROACH_SPEED = 1e-6
 
 
 def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -68,7 +62,7 @@ def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndar
 
 def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
              allowance: np.ndarray, events: EventLog, now: float, *,
-             jacobi_from: int = solver.JACOBI_FROM) -> int:  # fmt: skip
+             jacobi_from: int = JACOBI_FROM) -> int:  # fmt: skip
     """Bounce the contacts of ``c`` that arrive, wave after wave (the module's rule); velocities
     change in place. Returns the number of waves.
 
@@ -104,7 +98,7 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, th
 
 def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactRows,
                     allowance: np.ndarray, events: EventLog, now: float, *,
-                    jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
+                    jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
     """Stop every contact still closing faster than its ``allowance`` (e = 0), solved over the island
     of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
 
@@ -132,7 +126,7 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
 
 def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
            allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
-           seeds_among: np.ndarray | None = None, jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
+           seeds_among: np.ndarray | None = None, jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
     """The crowded step's bounce (until it calls ``in_waves``): the contacts that arrive bounce
     together with their whole island, each from the approach speed it had before any of them did.
 

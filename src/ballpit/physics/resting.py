@@ -17,11 +17,9 @@ from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows
+from .settings import JACOBI_FROM, WARM_START_SPAN
 from .solver import Impulses
 from .state import State, V, W, with_static
-
-# Resting forces found over less than this fraction of a step do not warm-start the next solve.
-WARM_START_SPAN = 0.5
 
 
 class WarmStart:
@@ -59,7 +57,7 @@ class WarmStart:
 
 def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,
                    ang: np.ndarray, h: float, dt: float, target: np.ndarray, warm: WarmStart,
-                   events: EventLog, now: float, jacobi_from: int = solver.JACOBI_FROM
+                   events: EventLog, now: float, jacobi_from: int = JACOBI_FROM
                    ) -> ConstantPerBall | None:  # fmt: skip
     """Constant contact forces over the next ``h`` seconds that leave each contact's normal speed at
     least ``target`` (0 for a touching contact, −gap/dt for a speculative one) at the interval's end.

@@ -23,21 +23,17 @@ from .contacts import SPHERE_PLANE, ContactPoints, EventLog
 from .forces import ConstantPerBall, ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
 from .model import Model
-from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache, contact_slop
+from .pairs import KeptPairs, PairCache, contact_slop
 from .profile import StepProfile
+from .settings import (
+    BROAD_PHASE_STEPS,
+    CONTACT_SLOP,
+    CROWD_PAIRS,
+    MAX_INTERVALS,
+    SPECULATIVE_REACH,
+    UNGUARDED_OVERLAP,
+)
 from .state import State, V, W, with_static
-
-# Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
-# meeting makes the step crowded (a pile, not a textbook scene).
-CROWD_PAIRS = 256
-# The pairs of a crowded step are those within this many times the distance they could close.
-SPECULATIVE_REACH = 2.0
-# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
-# fraction of the smaller radius cuts the step short at its impact.
-UNGUARDED_OVERLAP = 0.05
-# A step is split at most this many times; past it the rest of the step is finished conservatively:
-# the balls that could meet anything stop where they are (see ``finish_conservatively``).
-MAX_INTERVALS = 1_000
 
 
 @dataclass

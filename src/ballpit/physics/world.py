@@ -33,9 +33,6 @@ from .resting import WarmStart
 from .snapshot import Snapshot
 from .state import Q, State, V, W, X
 
-# The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
-DEFAULT_TIMESTEP = 1.0 / 240.0
-
 
 def _model_number(name: str, doc: str, **checks: bool) -> property:
     """A World parameter stored in the model, validated on the way in."""
