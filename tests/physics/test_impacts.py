@@ -155,7 +155,7 @@ def test_random_touching_clusters_struck_at_random_never_gain_energy():
 
 
 @pytest.mark.parametrize("gap", [0.0, 1e-3])
-def test_waves_with_the_crowded_steps_allowances_and_all_at_once_solves_pass_the_cradle_impulse(gap):
+def test_waves_with_the_crowded_steps_min_normal_speeds_and_jacobi_solves_pass_the_cradle_impulse(gap):
     # How a crowded step calls the rule: every contact within reach, speculative ones allowed to close
     # by gap/dt, and every solve by Jacobi sweeps (jacobi_from=0). The line still passes the impulse on.
     dt = 1 / 240
@@ -166,10 +166,10 @@ def test_waves_with_the_crowded_steps_allowances_and_all_at_once_solves_pass_the
     accel, _ = free_acceleration(state.body, model.forces())
     pairs = world._pairs.for_step(model, state, accel, dt)
     c = narrowphase.contact_points(model, state, pairs)
-    allowance = np.where(c.gap < 1e-5, 0.0, c.gap / dt)
+    min_normal_speed = np.where(c.gap < 1e-5, 0.0, -c.gap / dt)
     batch = rows.contact_rows(model, state, c)
     p = momentum(world)
-    waves = impacts.in_waves(model, state, c, batch, 0.0, allowance, EventLog(), 0.0, jacobi_from=0)
+    waves = impacts.in_waves(model, state, c, batch, 0.0, min_normal_speed, EventLog(), 0.0, jacobi_from=0)
     v = world.spheres.velocities[:, 0]
     assert waves == 5
     assert v[-1] == pytest.approx(2 * gap / dt + 1.0, rel=1e-12)

@@ -108,8 +108,9 @@ class Model:
             terms.append(AngularDrag(self.angular_drag))
         return terms
 
-    def bounce_threshold(self, dt: float) -> float:
-        """The approach speed below which contacts do not bounce.
+    def restitution_threshold_for(self, dt: float) -> float:
+        """The restitution threshold for a step of ``dt``: the approach speed (m/s) below which contacts
+        do not bounce, ``restitution_threshold`` when it is set.
 
         Default: the integrator's ``threshold_steps``·|g|·dt (2 for RK2 and RK4: a ball bouncing slower
         than 2·|g|·dt would land again within a step or two; 8 for explicit Euler, see integrators.py).

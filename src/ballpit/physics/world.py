@@ -294,7 +294,7 @@ class World:
         planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
-                               model.bounce_threshold(dt), EventLog(), StepProfile())  # fmt: skip
+                               model.restitution_threshold_for(dt), EventLog(), StepProfile())  # fmt: skip
         prof = step.profile
         with prof.stage("sleep"):
             sleep = state.sleep
@@ -338,7 +338,8 @@ class World:
             self._good_planes = planes
         state.time += dt
         record = step.events.record()
-        prof.pairs, prof.contacts, prof.crowded = len(pairs), len(record), crowd is not None
+        prof.intervals, prof.pairs, prof.contacts = step.intervals, len(pairs), len(record)
+        prof.crowded = crowd is not None
         prof.total = perf_counter() - began
         self.profile = prof
         return record
