@@ -1,10 +1,10 @@
 """The physics' tuning constants, in one place: each with its unit and why it has its value.
 
 The modules of the step import them from here (``from .settings import CONTACT_SLOP``), so this is the
-one file to read or change. What a user sets per world (``World(solver_iterations=...)``,
-``crowd_limit``, the timestep) only takes its default from here. The defaults of a ball's and a plane's
-own properties (``BALL_RADIUS``, ``FRICTION``, ...) stay in ``model.py`` beside the signatures the scene
-schema reads them from; the bounds on valid input stay in ``validation.py``.
+one file to read or change. What a user may set per world (``world.solver_iterations``,
+``world.crowd_limit``, a scene's timestep) only takes its default from here. The defaults of a ball's
+and a plane's own properties (``BALL_RADIUS``, ``FRICTION``, ...) stay in ``model.py``, beside the
+signatures the scene schema reads them from; the bounds on valid input stay in ``validation.py``.
 """
 
 from __future__ import annotations
