@@ -8,7 +8,7 @@ stages, so its cost is a floor for any crowded step made of them:
   that far (``broadphase.sphere_pairs``, ``pairs.plane_pairs``);
 - the narrow phase and contact rows of the engine (``narrowphase``, ``rows``);
 - one warm-started Jacobi solve (``jacobi.solve``) per step on the velocities after gravity, with
-  targets: a pair arriving faster than the bounce threshold leaves at e times its approach speed; a
+  targets: a pair arriving faster than the restitution threshold leaves at e times its approach speed; a
   pair with a gap closes by at most that gap, v_n ≥ −gap/dt; an overlap is pushed out at a fifth of
   its depth per step (Baumgarte), never faster than 1 m/s;
 - symplectic Euler: x += v·dt with the solved velocities (orientation is left alone: a sphere's
@@ -35,8 +35,9 @@ import numpy as np
 
 from ballpit.physics import broadphase, jacobi, narrowphase, rows, solver
 from ballpit.physics.contacts import ContactPoints
-from ballpit.physics.pairs import CONTACT_SLOP, KeptPairs, plane_pairs, plane_sides
+from ballpit.physics.pairs import KeptPairs, plane_pairs, plane_sides
 from ballpit.physics.resting import WarmStart
+from ballpit.physics.settings import CONTACT_SLOP
 from ballpit.physics.state import V, W, X, with_static
 from ballpit.scene import read_scene
 
@@ -57,7 +58,7 @@ def main() -> None:
     model, state, dt = world.model, world.state, args.dt
     body, radius = state.body, model.spheres.radius
     gravity = np.asarray(model.gravity, float)
-    threshold = model.bounce_threshold(dt)
+    restitution_threshold = model.restitution_threshold_for(dt)
     warm = WarmStart()
     kept, anchor = None, None
     free_fall = round(0.5 / dt)
@@ -85,7 +86,7 @@ def main() -> None:
         c, vn0 = c.subset(near), vn0[near]
         batch = rows.contact_rows(model, state, c)
         target = np.where(c.gap > 0.0, -c.gap / dt, np.minimum(-0.2 * c.gap / dt, 1.0))
-        arriving = (vn0 < -threshold) & (vn0 * dt < -c.gap)
+        arriving = (vn0 < -restitution_threshold) & (vn0 * dt < -c.gap)
         target = np.where(arriving, np.maximum(target, -batch.restitution * vn0), target)
         v[:-1] += gravity * dt
         keys = c.keys()

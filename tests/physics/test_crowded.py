@@ -1,7 +1,7 @@
 """Crowded steps: many impacts in one step are taken whole, with speculative contacts.
 
 A speculative contact lets a pair close by at most the gap it has, and a pair arriving faster than the
-bounce threshold leaves at e times the speed it had when the step began. The bounce then happens
+restitution threshold leaves at e times the speed it had when the step began. The bounce then happens
 early by at most the gap that was left, so results are checked against the analytic answer with
 that bound, never against numbers the code printed.
 """

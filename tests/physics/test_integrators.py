@@ -12,12 +12,12 @@ from ballpit.physics.forces import ConstantPerBall, Gravity, constant_accelerati
 from ballpit.physics.integrators import (
     INTEGRATOR_NAMES,
     INTEGRATORS,
-    RK4_CHUNK,
     Workspace,
     integrate,
     rk4,
     rk4_constant,
 )
+from ballpit.physics.settings import RK4_CHUNK
 from ballpit.physics.state import Q, V, W, X
 
 G = 9.81

@@ -8,6 +8,7 @@ import pytest
 from ballpit.physics import jacobi, solver
 from ballpit.physics.impulses import Impulses
 from ballpit.physics.rows import ContactRows
+from ballpit.physics.settings import JACOBI_FROM, JACOBI_SWEEPS
 
 G, DT, R, M = 9.81, 1 / 240, 0.5, 2.0
 
@@ -59,7 +60,7 @@ def test_a_resting_column_carries_the_weight_above_each_contact():
 
 
 def test_the_dispatch_gives_a_column_the_jacobi_solve_from_its_threshold_on():
-    n = solver.JACOBI_FROM
+    n = JACOBI_FROM
     rows = column(n)
     results = []
     for solve in (solver.solve, jacobi.solve):
@@ -71,7 +72,7 @@ def test_the_dispatch_gives_a_column_the_jacobi_solve_from_its_threshold_on():
     v = np.zeros((n + 1, 3))
     v[:n, 1] = -G * DT
     direct = jacobi.solve(rows, v, np.zeros((n + 1, 3)), np.zeros(n), Impulses.zeros(n),
-                          7 * solver.JACOBI_SWEEPS)  # fmt: skip
+                          7 * JACOBI_SWEEPS)  # fmt: skip
     assert np.array_equal(results[0], direct.normal)
 
 

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.pairs import CONTACT_SLOP
-from ballpit.physics.penetration import OVERLAP_TOLERANCE
+from ballpit.physics.settings import CONTACT_SLOP, OVERLAP_TOLERANCE
 
 G = 9.81
 RATES = [60, 240]

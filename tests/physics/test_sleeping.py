@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.sleeping import SLEEP_SPEED, TIME_TO_SLEEP, islands
+from ballpit.physics.settings import SLEEP_SPEED, TIME_TO_SLEEP
+from ballpit.physics.sleeping import islands
 
 DT = 1 / 240
 

@@ -8,8 +8,7 @@ import math
 import pytest
 
 import ballpit
-from ballpit.physics.pairs import CONTACT_SLOP
-from ballpit.physics.penetration import OVERLAP_TOLERANCE
+from ballpit.physics.settings import CONTACT_SLOP, OVERLAP_TOLERANCE
 
 G = 9.81
 

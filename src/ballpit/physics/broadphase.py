@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import exact
+from .settings import ALL_PAIRS_UP_TO, DENSE_CELLS_PER_BALL
 
 # The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
 _OFFSETS = np.array(
@@ -59,13 +60,6 @@ def within_reach(
     d = np.take(centre, i, axis=0) - np.take(centre, j, axis=0)
     keep = np.einsum("ij,ij->i", d, d) <= (np.take(reach, i) + np.take(reach, j)) ** 2
     return i[keep], j[keep]
-
-
-# The cells are looked up in a table when there are at most this many per ball (a pile), else by
-# searching the sorted cell keys (balls spread far apart).
-DENSE_CELLS_PER_BALL = 16
-# Up to this many boxes, testing every pair at once costs fewer array operations than the grid.
-ALL_PAIRS_UP_TO = 48
 
 
 def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

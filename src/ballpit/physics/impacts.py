@@ -41,22 +41,16 @@ from . import solver
 from .contacts import ContactPoints, EventLog
 from .model import Model
 from .rows import ContactRows
+from .settings import (
+    APPROACH_SPEED,
+    BOUNCE_HOPS,
+    BOUNCE_JACOBI_SWEEPS,
+    JACOBI_FROM,
+    MAX_WAVES,
+    WAVE_ITERATIONS,
+)
 from .solver import Impulses
 from .state import State, V, W, with_static
-
-# The most waves one impact sets off; what still arrives after them is stopped (e = 0). A touching
-# line needs one wave per ball.
-MAX_WAVES = 64
-# A wave is solved until no contact's speed changes by more than 1e-9 m/s in a sweep, or this many
-# sweeps (at least the world's solver_iterations): a ball struck from two sides needs about 15.
-WAVE_ITERATIONS = 50
-# The stop (and the crowded step's bounce) is solved over the contacts within this many balls of a
-# closing one.
-BOUNCE_HOPS = 3
-# A bounce is solved afresh (no warm start, nothing to hold at rest): Jacobi sweeps per iteration.
-BOUNCE_JACOBI_SWEEPS = 1
-# Normal speeds (m/s) below this count as not approaching (rounding, not an impact).
-APPROACH_SPEED = 1e-6
 
 
 def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -66,15 +60,16 @@ def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndar
     return rel[:, 0] * n[:, 0] + rel[:, 1] * n[:, 1] + rel[:, 2] * n[:, 2]
 
 
-def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
-             allowance: np.ndarray, events: EventLog, now: float, *,
-             jacobi_from: int = solver.JACOBI_FROM) -> int:  # fmt: skip
+def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, restitution_threshold: float,
+             min_normal_speed: np.ndarray, events: EventLog, now: float, *,
+             jacobi_from: int = JACOBI_FROM) -> int:  # fmt: skip
     """Bounce the contacts of ``c`` that arrive, wave after wave (the module's rule); velocities
     change in place. Returns the number of waves.
 
-    ``allowance`` (m/s) is how fast each contact may close without being stopped: zero for a touching
-    contact, gap/dt for a speculative one, which therefore arrives only when it closes faster than
-    that (and faster than ``threshold``). Slower approaches are left alone (``stop_approaches``).
+    ``min_normal_speed`` (m/s, ≤ 0) is the least normal speed each contact may have without being
+    stopped: zero for a touching contact, −gap/dt for a speculative one, which therefore arrives only
+    when it closes faster than gap/dt (and faster than ``restitution_threshold``). Slower approaches
+    are left alone (``stop_approaches``).
     """
     if len(c) == 0:
         return 0
@@ -84,7 +79,7 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, th
     iterations = max(model.solver_iterations, WAVE_ITERATIONS)
     while waves < MAX_WAVES:
         vn = normal_speeds(c, rows, v, w)
-        arriving = (vn < -(allowance + APPROACH_SPEED)) & (-vn > threshold)
+        arriving = (vn < min_normal_speed - APPROACH_SPEED) & (-vn > restitution_threshold)
         if not arriving.any():
             break
         idx = np.flatnonzero(arriving)
@@ -103,10 +98,10 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, th
 
 
 def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactRows,
-                    allowance: np.ndarray, events: EventLog, now: float, *,
-                    jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
-    """Stop every contact still closing faster than its ``allowance`` (e = 0), solved over the island
-    of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
+                    min_normal_speed: np.ndarray, events: EventLog, now: float, *,
+                    jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
+    """Stop every contact still closing faster than its ``min_normal_speed`` allows (e = 0), solved over
+    the island of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
 
     After ``in_waves`` these are the approaches slower than the restitution threshold, and whatever
     still arrives after MAX_WAVES waves. Inelastic impacts never add energy (checked as for a wave).
@@ -115,14 +110,15 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
     vn = normal_speeds(c, rows, v, w)
-    seeds = vn < -(allowance + APPROACH_SPEED)
+    seeds = vn < min_normal_speed - APPROACH_SPEED
     if not seeds.any():
         return
     near = _island(model, c, seeds)
     island = rows.subset(near)
     before = _velocities(island, v, w)
-    imp = solver.solve(island, v, w, -allowance[near], Impulses.zeros(len(island)), model.solver_iterations,
-                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
+    imp = solver.solve(island, v, w, min_normal_speed[near], Impulses.zeros(len(island)),
+                       model.solver_iterations, jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
+                       jacobi_from=jacobi_from)  # fmt: skip
     scale = _keep_energy(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]
@@ -130,23 +126,23 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     events.add(now, hit, hit.keys(), imp.normal * scale)
 
 
-def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, threshold: float,
-           allowance: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
-           seeds_among: np.ndarray | None = None, jacobi_from: int = solver.JACOBI_FROM) -> None:  # fmt: skip
+def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, restitution_threshold: float,
+           min_normal_speed: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
+           seeds_among: np.ndarray | None = None, jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
     """The crowded step's bounce (until it calls ``in_waves``): the contacts that arrive bounce
     together with their whole island, each from the approach speed it had before any of them did.
 
     This is the rule that moves a touching cradle on as one block; the split step no longer uses it.
-    ``allowance`` is as in ``in_waves``. With ``arrivals_only`` only arrivals faster than the threshold
-    start an island; otherwise any approach does (and the slow ones in it just stop). ``seeds_among``,
-    when given, is where islands may start (other contacts only join them).
+    ``min_normal_speed`` is as in ``in_waves``. With ``arrivals_only`` only arrivals faster than the
+    restitution threshold start an island; otherwise any approach does (and the slow ones in it just
+    stop). ``seeds_among``, when given, is where islands may start (other contacts only join them).
     """
     if len(c) == 0:
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
     vn = np.einsum("ij,ij->i", _relative_velocity(c, rows, v, w), c.normal)
-    approaching = vn < -(allowance + APPROACH_SPEED)
-    arriving = approaching & (-vn > threshold)
+    approaching = vn < min_normal_speed - APPROACH_SPEED
+    arriving = approaching & (-vn > restitution_threshold)
     seeds = arriving if arrivals_only else approaching
     if seeds_among is not None:
         seeds = seeds & seeds_among
@@ -154,7 +150,7 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, thre
         return
     near = _island(model, c, seeds)
     island = rows.subset(near)
-    target = np.where(arriving[near], -island.restitution * vn[near], -allowance[near])
+    target = np.where(arriving[near], -island.restitution * vn[near], min_normal_speed[near])
     imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations,
                        jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
     body = state.body

@@ -6,9 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# A sweep that changes no contact velocity by more than this (m/s) ends the iterations early.
-CONVERGED = 1e-9
-
 
 @dataclass
 class Impulses:

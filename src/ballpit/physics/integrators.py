@@ -22,6 +22,7 @@ import numpy as np
 
 from . import quaternion
 from .forces import ForceTerm, constant_acceleration
+from .settings import RK4_CHUNK
 from .state import Q, V, W, X
 
 
@@ -103,8 +104,6 @@ def rk4(state: np.ndarray, forces: Sequence[ForceTerm], h: float, ws: Workspace)
     state += acc
 
 
-# Balls the fast path takes at a time: its scratch columns then stay in the cache.
-RK4_CHUNK = 8192
 # The fast path's layout of a chunk, one ball per column: x, v, then q with its y and z repeated in
 # front (qy qz qx qy qz qw) and ω with its x and y repeated behind (ωx ωy ωz ωx ωy), so the rotated
 # copies ``_dq`` needs for ω × q are plain row slices.

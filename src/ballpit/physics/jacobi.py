@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .impulses import CONVERGED, Impulses, skew
+from .impulses import Impulses, skew
 from .rows import ContactRows
+from .settings import CONVERGED, SORT_ENDS_FROM
 
 
 class _Ends:
@@ -37,7 +38,7 @@ class _Ends:
         self.k = len(a)
         ab = np.concatenate((a, b))
         rows_in_world = int(ab.max(initial=-1)) + 1
-        if len(ab) * 8 < rows_in_world:  # few contacts in a big world: sorting them is cheaper
+        if len(ab) * SORT_ENDS_FROM < rows_in_world:  # few contacts in a big world: sorting them is cheaper
             self.balls, self.ends = np.unique(ab, return_inverse=True)
         else:  # the same compact numbering (balls in increasing order) from a table over the world
             present = np.zeros(rows_in_world, bool)

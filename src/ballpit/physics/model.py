@@ -12,16 +12,12 @@ import numpy as np
 from . import exact
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
+from .settings import CROWD_LIMIT, SOLVER_ITERATIONS
 from .state import Columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
 SOLID_INERTIA = 2.0 / 5.0
 HOLLOW_INERTIA = 2.0 / 3.0
-# A step in which more than this many pairs not yet touching may meet is taken whole, with
-# speculative contacts (see strategies.py).
-CROWD_LIMIT = 32
-# Projected Gauss–Seidel sweeps per solve.
-SOLVER_ITERATIONS = 10
 
 # Defaults of World.add_sphere/add_spheres/add_plane (the README's Python API); the scene schema
 # reads them from those signatures, so this is their one home.
@@ -112,8 +108,9 @@ class Model:
             terms.append(AngularDrag(self.angular_drag))
         return terms
 
-    def bounce_threshold(self, dt: float) -> float:
-        """The approach speed below which contacts do not bounce.
+    def restitution_threshold_for(self, dt: float) -> float:
+        """The restitution threshold for a step of ``dt``: the approach speed (m/s) below which contacts
+        do not bounce, ``restitution_threshold`` when it is set.
 
         Default: the integrator's ``threshold_steps``·|g|·dt (2 for RK2 and RK4: a ball bouncing slower
         than 2·|g|·dt would land again within a step or two; 8 for explicit Euler, see integrators.py).

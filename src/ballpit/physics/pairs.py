@@ -17,22 +17,15 @@ import numpy as np
 from . import broadphase, moving_planes
 from .integrators import Integrator
 from .model import Model
+from .settings import (
+    BROAD_PHASE_MARGIN,
+    BROAD_PHASE_REACH,
+    BROAD_PHASE_STEPS,
+    CONTACT_SLOP,
+    ESCAPE_CHUNK,
+    SLOP_PER_RADIUS,
+)
 from .state import State, V, X
-
-# Balls closer than this (m) are in contact: the solver holds them, time of impact stops here …
-CONTACT_SLOP = 1e-5
-# … or closer than this fraction of the smallest ball's radius, if that is less: a fixed 10 µm let a
-# 100 nm ball touch every wall of a 20 µm box at once, and leave it.
-SLOP_PER_RADIUS = 1e-3
-# Broad-phase boxes cover this many steps of each ball's path, so most steps reuse the pairs.
-BROAD_PHASE_STEPS = 4
-# … or as far as a ball travels this fraction of its radius, if that is sooner (but never less than
-# the step itself) …
-BROAD_PHASE_REACH = 0.2
-# … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
-BROAD_PHASE_MARGIN = 0.1
-# Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
-ESCAPE_CHUNK = 8192
 
 
 @dataclass

@@ -11,19 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, jacobi, solver
+from . import exact, jacobi
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
+from .settings import JACOBI_FROM, OVERLAP_PER_RADIUS, OVERLAP_TOLERANCE, PENETRATION_SWEEPS
 from .state import State, V, X, with_static
-
-# Overlaps shallower than this (m) are left alone: rounding, not penetration …
-OVERLAP_TOLERANCE = 1e-7
-# … or than this fraction of the smallest ball's radius, if that is less (a 100 nm ball could otherwise
-# sink its whole radius into a wall).
-OVERLAP_PER_RADIUS = 1e-5
-# Gauss–Seidel sweeps over the overlapping contacts.
-SWEEPS = 4
 
 
 def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
@@ -34,8 +27,8 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         return
     x = state.body[:, X]
     pos = with_static(x)
-    if len(c) >= solver.JACOBI_FROM:  # all contacts at once per sweep, with mass splitting
-        sweeps = 2 * SWEEPS  # a split ball moves only its share per sweep: twice the Gauss–Seidel count
+    if len(c) >= JACOBI_FROM:  # all contacts at once per sweep, with mass splitting
+        sweeps = 2 * PENETRATION_SWEEPS  # a split ball moves only its share per sweep: twice as many
         jacobi.separate(c.a, c.b, c.normal, c.gap, rows.inv_mass_a, rows.inv_mass_b, pos, sweeps)
     else:
         _separate_by_colour(c, rows, pos)
@@ -49,7 +42,7 @@ def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) ->
     n = c.normal
     offset = np.einsum("ij,ij->i", n, pos[c.a] - pos[c.b]) - c.gap
     share = rows.inv_mass_a / (rows.inv_mass_a + rows.inv_mass_b)
-    for _ in range(SWEEPS):
+    for _ in range(PENETRATION_SWEEPS):
         for idx in rows.colours:
             a, b = c.a[idx], c.b[idx]
             gap = np.einsum("ij,ij->i", n[idx], pos[a] - pos[b]) - offset[idx]

@@ -17,11 +17,9 @@ from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows
+from .settings import JACOBI_FROM, WARM_START_SPAN
 from .solver import Impulses
 from .state import State, V, W, with_static
-
-# Resting forces found over less than this fraction of a step do not warm-start the next solve.
-WARM_START_SPAN = 0.5
 
 
 class WarmStart:
@@ -58,11 +56,12 @@ class WarmStart:
 
 
 def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,
-                   ang: np.ndarray, h: float, dt: float, target: np.ndarray, warm: WarmStart,
-                   events: EventLog, now: float, jacobi_from: int = solver.JACOBI_FROM
+                   ang: np.ndarray, h: float, dt: float, min_normal_speed: np.ndarray, warm: WarmStart,
+                   events: EventLog, now: float, jacobi_from: int = JACOBI_FROM
                    ) -> ConstantPerBall | None:  # fmt: skip
     """Constant contact forces over the next ``h`` seconds that leave each contact's normal speed at
-    least ``target`` (0 for a touching contact, −gap/dt for a speculative one) at the interval's end.
+    least ``min_normal_speed`` (0 for a touching contact, −gap/dt for a speculative one) at the
+    interval's end.
 
     ``lin`` and ``ang`` are the free accelerations. The forces warm-start the next solve only when
     ``h`` is at least WARM_START_SPAN of the step ``dt``: the force that stops a slow arrival in the last
@@ -81,7 +80,7 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     if rows.moving and model.planes.angular_velocity.any():  # the contacts at the interval's end
         rows = moving_planes.rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
-    solver.solve(rows, v, w, target, imp, model.solver_iterations, jacobi_from=jacobi_from)
+    solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
     if h >= WARM_START_SPAN * dt:
         warm.keep(keys, imp, h)
     events.add_resting(now, c, keys, imp.normal)

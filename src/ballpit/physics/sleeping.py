@@ -24,13 +24,8 @@ import numpy as np
 from .contacts import SPHERE_SPHERE, ContactPoints
 from .forces import ConstantPerBall
 from .model import Model
-from .pairs import CONTACT_SLOP
+from .settings import CONTACT_SLOP, SLEEP_SPEED, TIME_TO_SLEEP
 from .state import Q, Sleep, State, V, W, X
-
-# A ball is still below this speed, and below this surface speed from spin |ω|·r (m/s; Box2D's default).
-SLEEP_SPEED = 0.05
-# An island falls asleep when all its balls have been still this long (s; Box2D's default).
-TIME_TO_SLEEP = 0.5
 
 
 def context(model: Model, state: State) -> tuple:

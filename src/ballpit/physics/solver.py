@@ -26,22 +26,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import jacobi
-from .impulses import CONVERGED, Impulses, cap, skew
+from .impulses import Impulses, cap, skew
 from .rows import ContactRows
-
-# From this many contacts on, a solve updates all of them at once (``jacobi.py``): per sweep it costs a
-# fixed number of NumPy calls instead of a few dozen per colour.
-JACOBI_FROM = 64
-# A Jacobi sweep with mass splitting moves each contact only part of the way a Gauss–Seidel update
-# would; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for (with one, a pile
-# of 200 balls kept jittering at 5 mm/s; with two it comes to rest below 1e-8 m/s).
-JACOBI_SWEEPS = 2
-# Friction and rolling resistance are updated in every fourth Jacobi sweep (and the last); the sweeps
-# between update the normal impulses alone, at about a fifth of the cost. Friction converges more
-# slowly than the normal impulses need it to, but its warm start carries it from step to step: the
-# 200-ball settling pile came to rest at 3e-10 m/s this way (2e-9 with friction in every sweep); with
-# friction in every tenth sweep of a bounce it kept creeping at 6 mm/s.
-JACOBI_FRICTION_EVERY = 4
+from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 
 
 class _Colour:

@@ -9,7 +9,9 @@
   (P. Firth, "Speculative contacts", 2011; as in Box2D v3 and Bullet): every pair that could meet
   joins the solves as a contact with a gap, which may close by at most that gap, v_n ≥ −gap/dt.
 
-``crowded_contacts`` decides between them. Each strategy passes its targets to the stages explicitly.
+``crowded_contacts`` decides between them. Each strategy passes the restitution threshold and each
+contact's minimum normal speed (v_n ≥ min_normal_speed: 0 touching, −gap/dt speculative) to the
+stages explicitly.
 """
 
 from __future__ import annotations
@@ -23,26 +25,27 @@ from .contacts import SPHERE_PLANE, ContactPoints, EventLog
 from .forces import ConstantPerBall, ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
 from .model import Model
-from .pairs import BROAD_PHASE_STEPS, CONTACT_SLOP, KeptPairs, PairCache, contact_slop
+from .pairs import KeptPairs, PairCache, contact_slop
 from .profile import StepProfile
+from .settings import (
+    BROAD_PHASE_STEPS,
+    CONTACT_SLOP,
+    CROWD_PAIRS,
+    MAX_INTERVALS,
+    SPECULATIVE_REACH,
+    UNGUARDED_OVERLAP,
+)
 from .state import State, V, W, with_static
-
-# Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
-# meeting makes the step crowded (a pile, not a textbook scene).
-CROWD_PAIRS = 256
-# The pairs of a crowded step are those within this many times the distance they could close.
-SPECULATIVE_REACH = 2.0
-# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
-# fraction of the smaller radius cuts the step short at its impact.
-UNGUARDED_OVERLAP = 0.05
-# A step is split at most this many times; past it the rest of the step is finished conservatively:
-# the balls that could meet anything stop where they are (see ``finish_conservatively``).
-MAX_INTERVALS = 1_000
 
 
 @dataclass
 class Step:
-    """What every stage of one step shares: the world's parts and this step's settings and outputs."""
+    """What every stage of one step shares: the world's parts and this step's settings and outputs.
+
+    ``intervals`` counts the intervals integrated so far in this step: the strategies read it (is this
+    the first interval? is the bound MAX_INTERVALS reached?), and ``World.step`` copies it into the
+    profile at the end, which only measures.
+    """
 
     model: Model
     state: State
@@ -51,9 +54,10 @@ class Step:
     workspace: Workspace
     forces: list[ForceTerm]
     dt: float
-    threshold: float  # restitution threshold (m/s)
+    restitution_threshold: float  # m/s, approach speed below which nothing bounces
     events: EventLog
     profile: StepProfile
+    intervals: int = 0
 
     def integrate(self, push: ForceTerm | None, h: float) -> None:
         """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``, and move
@@ -62,7 +66,7 @@ class Step:
             terms = self.forces if push is None else [*self.forces, push]
             integrate(self.model.integrator, self.state.body, terms, h, self.workspace)
             moving_planes.advance(self.model, self.state, h)
-        self.profile.intervals += 1
+        self.intervals += 1
 
 
 def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray | None:
@@ -122,7 +126,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
     start = state.time
     while elapsed < dt:
         remaining, now = dt - elapsed, start + elapsed
-        first = prof.intervals == 0
+        first = step.intervals == 0
         if not first:
             with prof.stage("narrow phase"):
                 contacts = narrowphase.contact_points(model, state, pairs)
@@ -131,15 +135,16 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
             batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):
             penetration.remove_penetration(model, state, touching, batch)
-        closing = np.zeros(len(touching))  # touching contacts may not close at all: allowance and target
+        min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
         with prof.stage("impacts"):  # arrivals bounce in waves; then slower approaches stop
-            impacts.in_waves(model, state, touching, batch, step.threshold, closing, step.events, now)
-            impacts.stop_approaches(model, state, touching, batch, closing, step.events, now)
+            impacts.in_waves(model, state, touching, batch, step.restitution_threshold, min_normal_speed,
+                             step.events, now)  # fmt: skip
+            impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now)
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, step.forces)
         with prof.stage("resting solve"):
             push = resting.resting_forces(model, state, touching, batch, free, ang, remaining, dt,
-                                          closing, step.warm, step.events, now)  # fmt: skip
+                                          min_normal_speed, step.warm, step.events, now)  # fmt: skip
         lin = free if push is None else free + push.lin
         # The first interval's free path was checked against the boxes when the pairs were taken; a
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again
@@ -149,7 +154,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
                 pairs = step.pairs.renew(model, state, remaining, ahead, lin, free)
                 contacts = narrowphase.contact_points(model, state, pairs)
-        if prof.intervals + 1 >= MAX_INTERVALS:  # a pathological pile-up: no more splitting
+        if step.intervals + 1 >= MAX_INTERVALS:  # a pathological pile-up: no more splitting
             finish_conservatively(step, contacts, push, lin, remaining)
             step.events.close_interval(1.0)
             return
@@ -185,11 +190,11 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
     """The whole step as one interval, with speculative contacts: those of ``contacts`` (all the kept
     ``pairs`` measured now) where ``solved`` holds (from ``crowded_contacts``).
 
-    A contact with a gap may close by at most that gap, v_n ≥ −gap/dt, and the constraint only pushes
-    if the pair would otherwise pass it. A pair arriving faster than the bounce threshold leaves at e
-    times its approach speed, as in a split step, but from where it was when the step began: a bounce
-    is early by at most the gap it had left (≤ v·dt). Slower approaches start no bounce island; the
-    resting forces stop them within the step.
+    A contact with a gap may close by at most that gap: its minimum normal speed is −gap/dt, and the
+    constraint only pushes if the pair would otherwise pass it. A pair arriving faster than the
+    restitution threshold leaves at e times its approach speed, as in a split step, but from where it
+    was when the step began: a bounce is early by at most the gap it had left (≤ v·dt). Slower
+    approaches start no bounce island; the resting forces stop them within the step.
 
     A bounce can turn a ball towards a body it was not near, whose pair is not among ``c``. Before
     moving, every such pair is followed along the new paths; if one would overlap by more than
@@ -199,13 +204,13 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
     """
     model, state, prof, dt, now = step.model, step.state, step.profile, step.dt, step.state.time
     c = contacts.subset(solved)
-    allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)  # how fast each may close (m/s)
+    min_normal_speed = np.where(c.gap < CONTACT_SLOP, 0.0, -c.gap / dt)  # each may close by its gap (m/s)
     with prof.stage("contact rows"):
         batch = rows.contact_rows(model, state, c)
     with prof.stage("penetration"):
         penetration.remove_penetration(model, state, c, batch)
     with prof.stage("impacts"):
-        impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
+        impacts.bounce(model, state, c, batch, step.restitution_threshold, min_normal_speed, step.events, now,
                        arrivals_only=True, jacobi_from=0)  # fmt: skip
     free, ang = free_acceleration(state.body, step.forces)
     # The bounces turned some balls towards neighbours they were not closing on before: those pairs
@@ -216,18 +221,18 @@ def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: 
         solved = solved | joined
         new = np.r_[np.zeros(len(c), bool), np.ones(np.count_nonzero(joined), bool)]
         c = ContactPoints.concatenate([c, contacts.subset(joined)])
-        allowance = np.where(c.gap < CONTACT_SLOP, 0.0, c.gap / dt)
+        min_normal_speed = np.where(c.gap < CONTACT_SLOP, 0.0, -c.gap / dt)
         with prof.stage("contact rows"):
             batch = rows.contact_rows(model, state, c)
         # Only the joined pairs start islands: a contact the first pass bounced and that still closes
         # is caught between neighbours bouncing too, and the resting solve stops it.
         with prof.stage("impacts"):
-            impacts.bounce(model, state, c, batch, step.threshold, allowance, step.events, now,
-                           arrivals_only=True, seeds_among=new, jacobi_from=0)  # fmt: skip
+            impacts.bounce(model, state, c, batch, step.restitution_threshold, min_normal_speed,
+                           step.events, now, arrivals_only=True, seeds_among=new, jacobi_from=0)  # fmt: skip
         free, ang = free_acceleration(state.body, step.forces)
     with prof.stage("resting solve"):
-        push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, -allowance, step.warm,
-                                      step.events, now, jacobi_from=0)  # fmt: skip
+        push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, min_normal_speed,
+                                      step.warm, step.events, now, jacobi_from=0)  # fmt: skip
     lin = free if push is None else free + push.lin
     with prof.stage("pairs"):
         if pairs.escaped(model, state, lin, dt):

@@ -18,16 +18,8 @@ from . import collision, moving_planes
 from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
 from .pairs import contact_slop
+from .settings import IMPACT_OVERLAP, LEAP_AFTER, MAX_ADVANCE_STEPS
 from .state import State, V, X, with_static
-
-# Impacts whose times are this close (as an overlap, in radii) are resolved together: a pile of 1,000
-# balls landing then takes ~4 intervals per step instead of ~19. A lone impact is still met exactly.
-IMPACT_OVERLAP = 0.005
-# Conservative advancement steps by gap / (closing-speed bound), and the bound counts the speed along
-# the surface: a ball hopping a tenth of a millimetre while it rolls at 3 m/s took 48 steps and more to
-# land. A pair still advancing after this many steps leaps to the earliest time its gap along the
-# normal could close (``earliest``); the pairs that land within them are found exactly as before.
-LEAP_AFTER = 8
 
 
 def first_contact(
@@ -35,7 +27,7 @@ def first_contact(
     speed_bound: np.ndarray,
     t_max: float,
     tolerance: float | np.ndarray,
-    max_iterations: int = 48,
+    max_iterations: int = MAX_ADVANCE_STEPS,
     start: np.ndarray | None = None,
 ) -> np.ndarray:
     """Earliest time in [0, t_max] at which each pair's gap falls to ``tolerance`` (one for all, or

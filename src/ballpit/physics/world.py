@@ -33,9 +33,6 @@ from .resting import WarmStart
 from .snapshot import Snapshot
 from .state import Q, State, V, W, X
 
-# The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
-DEFAULT_TIMESTEP = 1.0 / 240.0
-
 
 def _model_number(name: str, doc: str, **checks: bool) -> property:
     """A World parameter stored in the model, validated on the way in."""
@@ -297,7 +294,7 @@ class World:
         planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
-                               model.bounce_threshold(dt), EventLog(), StepProfile())  # fmt: skip
+                               model.restitution_threshold_for(dt), EventLog(), StepProfile())  # fmt: skip
         prof = step.profile
         with prof.stage("sleep"):
             sleep = state.sleep
@@ -341,7 +338,8 @@ class World:
             self._good_planes = planes
         state.time += dt
         record = step.events.record()
-        prof.pairs, prof.contacts, prof.crowded = len(pairs), len(record), crowd is not None
+        prof.intervals, prof.pairs, prof.contacts = step.intervals, len(pairs), len(record)
+        prof.crowded = crowd is not None
         prof.total = perf_counter() - began
         self.profile = prof
         return record

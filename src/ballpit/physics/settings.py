@@ -1,0 +1,137 @@
+"""The physics' tuning constants, in one place: each with its unit and why it has its value.
+
+The modules of the step import them from here (``from .settings import CONTACT_SLOP``), so this is the
+one file to read or change. What a user may set per world (``world.solver_iterations``,
+``world.crowd_limit``, a scene's timestep) only takes its default from here. The defaults of a ball's
+and a plane's own properties (``BALL_RADIUS``, ``FRICTION``, ...) stay in ``model.py``, beside the
+signatures the scene schema reads them from; the bounds on valid input stay in ``validation.py``.
+"""
+
+from __future__ import annotations
+
+# --- The step -------------------------------------------------------------------------------------
+
+# The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
+DEFAULT_TIMESTEP = 1.0 / 240.0
+# A step is split at most this many times (intervals); past it the rest of the step is finished
+# conservatively: the balls that could meet anything stop where they are
+# (``strategies.finish_conservatively``). A pathological pile-up, not a textbook scene, gets there.
+MAX_INTERVALS = 1_000
+
+# --- Contact ----------------------------------------------------------------------------------------
+
+# Balls closer than this (m) are in contact: the solver holds them, time of impact stops here …
+CONTACT_SLOP = 1e-5
+# … or closer than this fraction of the smallest ball's radius, if that is less: a fixed 10 µm let a
+# 100 nm ball touch every wall of a 20 µm box at once, and leave it.
+SLOP_PER_RADIUS = 1e-3
+
+# --- Broad phase (pairs.py, broadphase.py) ------------------------------------------------------------
+
+# Broad-phase boxes cover this many steps of each ball's path, so most steps reuse the pairs.
+BROAD_PHASE_STEPS = 4
+# … or as far as a ball travels this fraction of its radius, if that is sooner (but never less than
+# the step itself) …
+BROAD_PHASE_REACH = 0.2
+# … and are grown by this fraction of the ball's radius, so slow balls keep their pairs for longer.
+BROAD_PHASE_MARGIN = 0.1
+# The cells are looked up in a table when there are at most this many per ball (a pile), else by
+# searching the sorted cell keys (balls spread far apart).
+DENSE_CELLS_PER_BALL = 16
+# Up to this many boxes, testing every pair at once costs fewer array operations than the grid.
+ALL_PAIRS_UP_TO = 48
+# Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
+ESCAPE_CHUNK = 8192
+
+# --- Crowded steps (strategies.py) ------------------------------------------------------------------
+
+# Default of ``World.crowd_limit``: a step in which more than this many pairs not yet touching may meet
+# is taken whole, with speculative contacts.
+CROWD_LIMIT = 32
+# Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
+# meeting makes the step crowded (a pile, not a textbook scene).
+CROWD_PAIRS = 256
+# The pairs of a crowded step are those within this many times the distance they could close.
+SPECULATIVE_REACH = 2.0
+# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
+# fraction of the smaller radius cuts the step short at its impact.
+UNGUARDED_OVERLAP = 0.05
+
+# --- Time of impact (toi.py) ------------------------------------------------------------------------
+
+# Impacts whose times are this close (as an overlap, in radii) are resolved together: a pile of 1,000
+# balls landing then takes ~4 intervals per step instead of ~19. A lone impact is still met exactly.
+IMPACT_OVERLAP = 0.005
+# Conservative advancement steps by gap / (closing-speed bound), and the bound counts the speed along
+# the surface: a ball hopping a tenth of a millimetre while it rolls at 3 m/s took 48 steps and more to
+# land. A pair still advancing after this many steps leaps to the earliest time its gap along the
+# normal could close (``toi.earliest``); the pairs that land within them are found exactly as before.
+LEAP_AFTER = 8
+# Conservative advancement steps per call: a pair still converging after them reports the time it
+# reached, a safe lower bound, and the step integrates to it and asks again.
+MAX_ADVANCE_STEPS = 48
+
+# --- Penetration (penetration.py) -------------------------------------------------------------------
+
+# Overlaps shallower than this (m) are left alone: rounding, not penetration …
+OVERLAP_TOLERANCE = 1e-7
+# … or than this fraction of the smallest ball's radius, if that is less (a 100 nm ball could otherwise
+# sink its whole radius into a wall).
+OVERLAP_PER_RADIUS = 1e-5
+# Gauss–Seidel sweeps over the overlapping contacts (twice as many Jacobi sweeps, which move a split
+# ball only its share).
+PENETRATION_SWEEPS = 4
+
+# --- Impacts (impacts.py) ---------------------------------------------------------------------------
+
+# The most waves one impact sets off; what still arrives after them is stopped (e = 0). A touching
+# line needs one wave per ball.
+MAX_WAVES = 64
+# A wave is solved until no contact's speed changes by more than CONVERGED in a sweep, or this many
+# sweeps (at least the world's solver_iterations): a ball struck from two sides needs about 15.
+WAVE_ITERATIONS = 50
+# The stop (and the crowded step's bounce) is solved over the contacts within this many balls of a
+# closing one.
+BOUNCE_HOPS = 3
+# A bounce is solved afresh (no warm start, nothing to hold at rest): Jacobi sweeps per iteration.
+BOUNCE_JACOBI_SWEEPS = 1
+# Normal speeds (m/s) within this of a contact's minimum normal speed count as not approaching
+# (rounding, not an impact).
+APPROACH_SPEED = 1e-6
+
+# --- Contact solves (solver.py, jacobi.py, impulses.py, resting.py) ---------------------------------
+
+# Default of ``World.solver_iterations``: projected Gauss–Seidel sweeps per solve.
+SOLVER_ITERATIONS = 10
+# A sweep that changes no contact velocity by more than this (m/s) ends the iterations early.
+CONVERGED = 1e-9
+# From this many contacts on, a solve updates all of them at once (``jacobi.py``): per sweep it costs a
+# fixed number of NumPy calls instead of a few dozen per colour.
+JACOBI_FROM = 64
+# A Jacobi sweep with mass splitting moves each contact only part of the way a Gauss–Seidel update
+# would; it takes this many Jacobi sweeps for each Gauss–Seidel iteration asked for (with one, a pile
+# of 200 balls kept jittering at 5 mm/s; with two it comes to rest below 1e-8 m/s).
+JACOBI_SWEEPS = 2
+# Friction and rolling resistance are updated in every fourth Jacobi sweep (and the last); the sweeps
+# between update the normal impulses alone, at about a fifth of the cost. Friction converges more
+# slowly than the normal impulses need it to, but its warm start carries it from step to step: the
+# 200-ball settling pile came to rest at 3e-10 m/s this way (2e-9 with friction in every sweep); with
+# friction in every tenth sweep of a bounce it kept creeping at 6 mm/s.
+JACOBI_FRICTION_EVERY = 4
+# A Jacobi solve numbers the balls its contacts touch by sorting the contact ends when the world has
+# more than this many balls per end (few contacts in a big world), else from a table over the world.
+SORT_ENDS_FROM = 8
+# Resting forces found over less than this fraction of a step do not warm-start the next solve.
+WARM_START_SPAN = 0.5
+
+# --- Sleeping (sleeping.py) -------------------------------------------------------------------------
+
+# A ball is still below this speed, and below this surface speed from spin |ω|·r (m/s; Box2D's default).
+SLEEP_SPEED = 0.05
+# An island falls asleep when all its balls have been still this long (s; Box2D's default).
+TIME_TO_SLEEP = 0.5
+
+# --- Integration (integrators.py) -------------------------------------------------------------------
+
+# Balls RK4's fast path takes at a time: its scratch columns then stay in the cache.
+RK4_CHUNK = 8192
