@@ -41,7 +41,7 @@ def advance(model: Model, state: State, h: float) -> None:
     """
     pl, pose = model.planes, state.planes
     velocity, spin = pl.velocity, pl.angular_velocity
-    moving = np.flatnonzero(velocity.any(axis=1) | spin.any(axis=1))
+    moving = np.flatnonzero(model.moving_plane_mask())
     if moving.size == 0:
         return
     center, orientation = pose.center, pose.orientation
