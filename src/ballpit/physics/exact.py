@@ -100,7 +100,7 @@ def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     (p₁q₂ − p₂q₁, p₂q₀ − p₀q₂, p₀q₁ − p₁q₀), so the bits are the same, without its axis shuffling,
     which costs several times the arithmetic on a few rows."""
     p, q = np.asarray(p, float), np.asarray(q, float)
-    out = np.empty(np.broadcast_shapes(p.shape, q.shape))
+    out = np.empty(p.shape if p.shape == q.shape else np.broadcast_shapes(p.shape, q.shape))
     p0, p1, p2 = p[..., 0], p[..., 1], p[..., 2]
     q0, q1, q2 = q[..., 0], q[..., 1], q[..., 2]
     np.subtract(p1 * q2, p2 * q1, out=out[..., 0])
