@@ -125,8 +125,13 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     """How far a point of ``plane`` within ``distance`` of its centre can move in ``h``:
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
-    shift = float(exact.norm(pl.velocity[plane])) * h
-    return shift + float(exact.norm(pl.angular_velocity[plane])) * h * (distance + shift)
+    shift = _length(pl.velocity[plane].tolist()) * h
+    return shift + _length(pl.angular_velocity[plane].tolist()) * h * (distance + shift)
+
+
+def _length(x: list[float]) -> float:
+    """|x| of one 3-vector in Python floats, its squares summed in ``exact.norm``'s order."""
+    return math.sqrt((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
 
 
 def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.ndarray, v: np.ndarray,
