@@ -60,3 +60,13 @@ def test_total_adds_from_first_to_last():
     assert exact.total(np.array([1.0, 2.0**-53, 2.0**-53])) == 1.0
     assert exact.total(np.array([2.0**-53, 2.0**-53, 1.0])) == 1.0 + 2.0**-52
     assert exact.total(np.zeros(0)) == 0.0
+
+
+def test_cross_gives_the_bits_of_numpy_cross_for_every_broadcast():
+    rng = np.random.default_rng(11)
+    for shape_p, shape_q in [((500, 3), (500, 3)), ((3,), (3, 3)), ((500, 3), (3,)), ((4, 1, 3), (1, 6, 3))]:
+        p = rng.standard_normal(shape_p) * rng.choice([0.0, -0.0, 1.0, 1e-300, 1e300], size=shape_p)
+        q = rng.standard_normal(shape_q) * rng.choice([0.0, -0.0, 1.0, 3.0], size=shape_q)
+        got = exact.cross(p, q)
+        assert got.shape == np.cross(p, q).shape
+        assert got.tobytes() == np.cross(p, q).tobytes()

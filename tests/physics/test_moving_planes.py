@@ -152,3 +152,63 @@ def test_plane_motion_is_validated_and_kept_in_snapshots():
     assert plane.position[1] == pytest.approx(0.5)
     world.restore(snap)
     assert plane.position[1] == 0.0 and plane.velocity[1] == 1.0
+
+
+def test_kept_pairs_of_still_planes_are_the_pairs_found_afresh_while_another_plane_moves():
+    # While a plane moves, only the planes that move now or moved when their pairs were found have
+    # them found again each step; the still planes' kept pairs must be exactly what finding every
+    # plane's again gives, in the same order, also for a plane that has just stopped.
+    import copy
+
+    from ballpit.physics.pairs import plane_pairs, refresh_moving
+
+    dt = 1 / 240
+    world = ballpit.World()
+    world.add_plane(restitution=0.3)  # floor, still
+    plank = world.add_plane(position=(0, 1, 0), size=(4, 2), angular_velocity=(0, 0, -0.3))
+    paddle = world.add_plane(position=(2.5, 1, 0), normal=(-1, 0, 0), size=(2, 3), velocity=(-0.3, 0, 0))
+    positions = np.random.default_rng(2).uniform((-1.5, 0.2, -0.5), (2.3, 2.5, 0.5), (12, 3))
+    world.add_spheres(positions, radius=0.15)
+    compared = 0
+    for k in range(360):
+        if k == 100:
+            paddle.velocity = (0, 0, 0)  # its pairs were found while it moved: found again once
+        if k == 220:
+            plank.angular_velocity = (0, 0, 0)
+            paddle.velocity = (0.2, 0, 0)
+        kept = world._pairs.kept
+        if kept is not None:
+            model, state = world.model, world.state
+            refreshed = copy.deepcopy(kept)
+            refresh_moving(model, state, refreshed, dt)
+            sphere, plane = plane_pairs(model, state, kept.lo, kept.hi, dt)
+            assert refreshed.sphere.tolist() == sphere.tolist()
+            assert refreshed.plane.tolist() == plane.tolist()
+            compared += len(sphere)
+        world.step(dt)
+    assert compared > 1000  # the balls were near the planes throughout
+
+
+def test_a_turning_plane_is_moved_as_the_quaternion_functions_move_it_bit_for_bit():
+    # advance works each plane in Python floats; its pose must be the one quaternion.from_axis_angle,
+    # multiply, normalize and rotate give (exact.norm for the normal), to the last bit.
+    from ballpit.physics import exact, moving_planes, quaternion
+
+    rng = np.random.default_rng(4)
+    world = ballpit.World()
+    for _ in range(3):
+        world.add_plane(position=rng.standard_normal(3), rotation=rng.uniform(-180, 180, 3), size=1.0,
+                        velocity=rng.standard_normal(3), angular_velocity=rng.standard_normal(3))  # fmt: skip
+    pose, spin = world.state.planes, world.model.planes.angular_velocity
+    for h in (1 / 240, 1 / 60, 3.7e-4, 1 / 240):
+        center = pose.center + world.model.planes.velocity * h
+        rate = np.linalg.norm(spin, axis=1)
+        turn = quaternion.from_axis_angle(spin / rate[:, None], rate * h)
+        q = quaternion.normalize(quaternion.multiply(turn, pose.orientation))
+        axes = [quaternion.rotate(qi, np.eye(3)) for qi in q]
+        moving_planes.advance(world.model, world.state, h)
+        assert pose.center.tobytes() == center.tobytes()
+        assert pose.orientation.tobytes() == q.tobytes()
+        assert pose.axis_u.tobytes() == np.array([a[0] for a in axes]).tobytes()
+        assert pose.normal.tobytes() == np.array([a[1] / exact.norm(a[1]) for a in axes]).tobytes()
+        assert pose.axis_v.tobytes() == np.array([a[2] for a in axes]).tobytes()

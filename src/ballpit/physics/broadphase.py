@@ -197,8 +197,10 @@ def sphere_plane_pairs(
     axis_v: np.ndarray,
     half_size: np.ndarray,
     sweep=None,
+    only: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs (sphere, plane) whose box reaches the plane's rectangle.
+    """Pairs (sphere, plane) whose box reaches the plane's rectangle, plane by plane (the planes
+    ``only`` names, in order; all of them when None), each plane's balls in order.
 
     ``sweep(p, d)``, when given, is how far a point of plane ``p`` at distance ``d`` from its centre
     may move (a moving plane); a box that close counts too.
@@ -209,7 +211,7 @@ def sphere_plane_pairs(
     box_center = 0.5 * (lo + hi)
     box_radius = 0.5 * np.linalg.norm(hi - lo, axis=1)
     spheres, planes = [], []
-    for p in range(len(center)):
+    for p in range(len(center)) if only is None else only.tolist():
         d = box_center - center[p]
         du = np.abs(exact.dot(d, axis_u[p])) - half_size[p, 0]
         dv = np.abs(exact.dot(d, axis_v[p])) - half_size[p, 1]

@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from . import solver
+from . import exact, solver
 from .contacts import ContactPoints, EventLog
 from .model import Model
 from .rows import ContactRows
@@ -163,7 +163,7 @@ def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, rest
 def _relative_velocity(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Each contact point's velocity of a relative to b (to a moving plane's surface), (K, 3)."""
     va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
-    rel = va + np.cross(wa, rows.arm_a) - vb - np.cross(wb, rows.arm_b)
+    rel = va + exact.cross(wa, rows.arm_a) - vb - exact.cross(wb, rows.arm_b)
     if rows.moving:
         rel -= rows.surface
     return rel

@@ -99,6 +99,11 @@ class Model:
         pl = self.planes
         return bool(pl.velocity.any() or pl.angular_velocity.any())
 
+    def moving_plane_mask(self) -> np.ndarray:
+        """Which planes have a velocity or an angular velocity, one flag per plane."""
+        pl = self.planes
+        return pl.velocity.any(axis=1) | pl.angular_velocity.any(axis=1)
+
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""
         terms: list[ForceTerm] = [Gravity(self.gravity)]

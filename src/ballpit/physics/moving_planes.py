@@ -27,31 +27,80 @@ if TYPE_CHECKING:  # rows.py imports this module
 
 def set_orientation(pose: Columns, i: int, q: np.ndarray) -> None:
     """Store orientation ``q`` of plane ``i`` with the axes it gives: x (width), y (normal) and z."""
-    axes = quaternion.rotate(q, np.eye(3))  # rows: the plane's x, y (normal) and z axes
-    pose.full("orientation")[i] = q
-    pose.full("axis_u")[i] = axes[0]
-    pose.full("normal")[i] = axes[1] / exact.norm(axes[1])
-    pose.full("axis_v")[i] = axes[2]
+    _store_orientation(pose, i, tuple(np.asarray(q, float).tolist()))
 
 
 def advance(model: Model, state: State, h: float) -> None:
     """Move every plane along its velocity and turn it about its centre by ω·h (exactly, not a
-    first-order update, so a plane turned for a long time stays a rectangle)."""
+    first-order update, so a plane turned for a long time stays a rectangle).
+
+    A few planes, not balls: each is worked in Python floats, whose +, −, × and ÷ are the same
+    correctly rounded operations as NumPy's elementwise ones and are taken in the same order as
+    ``quaternion.multiply``, ``quaternion.normalize`` and ``quaternion.rotate`` take them (the same bits,
+    without a dozen NumPy calls on one row each).
+    """
     pl, pose = model.planes, state.planes
-    moving = np.flatnonzero(pl.velocity.any(axis=1) | pl.angular_velocity.any(axis=1))
+    velocity, spin = pl.velocity, pl.angular_velocity
+    moving = np.flatnonzero(model.moving_plane_mask())
     if moving.size == 0:
         return
-    pose.center[moving] += pl.velocity[moving] * h
-    spin = pl.angular_velocity[moving]
-    rate = np.linalg.norm(spin, axis=1)
-    turning = rate > 0.0
-    if turning.any():
-        rows = moving[turning]
-        axis = spin[turning] / rate[turning, None]
-        turn = quaternion.from_axis_angle(axis, rate[turning] * h)
-        q = quaternion.normalize(quaternion.multiply(turn, pose.orientation[rows]))
-        for i, qi in zip(rows, q, strict=True):  # a few planes, not balls
-            set_orientation(pose, i, qi)
+    center, orientation = pose.center, pose.orientation
+    for i in moving.tolist():
+        (cx, cy, cz), (vx, vy, vz) = center[i].tolist(), velocity[i].tolist()
+        center[i] = (cx + vx * h, cy + vy * h, cz + vz * h)
+        wx, wy, wz = spin[i].tolist()
+        rate = math.sqrt((wx * wx + wy * wy) + wz * wz)  # as np.linalg.norm sums a row
+        if rate > 0.0:
+            px, py, pz, pw = _turn(wx, wy, wz, rate, h)
+            qx, qy, qz, qw = orientation[i].tolist()
+            # the Hamilton product turn ⊗ q (quaternion.multiply), then q / |q| (quaternion.normalize)
+            x = pw * qx + px * qw + py * qz - pz * qy
+            y = pw * qy - px * qz + py * qw + pz * qx
+            z = pw * qz + px * qy - py * qx + pz * qw
+            w = pw * qw - px * qx - py * qy - pz * qz
+            size = math.sqrt((x * x + z * z) + (y * y + w * w))  # the order einsum sums four terms in
+            _store_orientation(pose, i, (x / size, y / size, z / size, w / size))
+
+
+# The turn of a plane turning at ω over h, by (ω, h): a plane turning steadily turns by the same
+# quaternion every whole step, so its sine and cosine (exact.sin_cos) are worked out once. Keyed by the
+# bits, so −0 and +0 stay apart.
+_TURNS: dict[bytes, tuple[float, float, float, float]] = {}
+_TURNS_KEPT = 256
+
+
+def _turn(wx: float, wy: float, wz: float, rate: float, h: float) -> tuple[float, float, float, float]:
+    """The rotation by rate·h about ω / rate (``quaternion.from_axis_angle``), as four floats."""
+    key = np.array((wx, wy, wz, rate, h)).tobytes()
+    turn = _TURNS.get(key)
+    if turn is None:
+        if len(_TURNS) >= _TURNS_KEPT:
+            _TURNS.clear()
+        sin, cos = (float(f) for f in exact.sin_cos(np.array(0.5 * (rate * h))))
+        turn = _TURNS[key] = (wx / rate * sin, wy / rate * sin, wz / rate * sin, cos)
+    return turn
+
+
+def _store_orientation(pose: Columns, i: int, q: tuple[float, float, float, float]) -> None:
+    """Store unit quaternion ``q`` of plane ``i`` and the axes it turns x, y and z to, each formed as
+    ``quaternion.rotate`` forms it (v + w·t + u × t with t = 2·u × v, u the vector part, and
+    ``exact.cross``'s order), the normal divided by its length (``exact.norm``)."""
+    ux, uy, uz, w = q
+
+    def rotate(vx: float, vy: float, vz: float) -> tuple[float, float, float]:
+        tx, ty, tz = 2.0 * (uy * vz - uz * vy), 2.0 * (uz * vx - ux * vz), 2.0 * (ux * vy - uy * vx)
+        return (
+            vx + w * tx + (uy * tz - uz * ty),
+            vy + w * ty + (uz * tx - ux * tz),
+            vz + w * tz + (ux * ty - uy * tx),
+        )
+
+    nx, ny, nz = rotate(0.0, 1.0, 0.0)
+    size = math.sqrt((nx * nx + ny * ny) + nz * nz)
+    pose.full("orientation")[i] = q
+    pose.full("axis_u")[i] = rotate(1.0, 0.0, 0.0)
+    pose.full("normal")[i] = (nx / size, ny / size, nz / size)
+    pose.full("axis_v")[i] = rotate(0.0, 0.0, 1.0)
 
 
 def surface_velocity(model: Model, state: State, plane: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -76,8 +125,13 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     """How far a point of ``plane`` within ``distance`` of its centre can move in ``h``:
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
-    shift = float(exact.norm(pl.velocity[plane])) * h
-    return shift + float(exact.norm(pl.angular_velocity[plane])) * h * (distance + shift)
+    shift = _length(pl.velocity[plane].tolist()) * h
+    return shift + _length(pl.angular_velocity[plane].tolist()) * h * (distance + shift)
+
+
+def _length(x: list[float]) -> float:
+    """|x| of one 3-vector in Python floats, its squares summed in ``exact.norm``'s order."""
+    return math.sqrt((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
 
 
 def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.ndarray, v: np.ndarray,
@@ -146,9 +200,5 @@ def _dot(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Row-wise p × q of (K, 3) arrays (np.cross costs several times more on a few rows)."""
-    out = np.empty(np.broadcast_shapes(p.shape, q.shape))
-    out[:, 0] = p[:, 1] * q[:, 2] - p[:, 2] * q[:, 1]
-    out[:, 1] = p[:, 2] * q[:, 0] - p[:, 0] * q[:, 2]
-    out[:, 2] = p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]
-    return out
+    """Row-wise p × q of (K, 3) arrays (``exact.cross``: np.cross costs several times more on a few rows)."""
+    return exact.cross(p, q)

@@ -5,7 +5,8 @@ Boxes are swept over BROAD_PHASE_STEPS steps ahead, so most steps reuse their pa
 each ball is on of each plane is refreshed (a ball moved by hand may have crossed one). The pairs
 expire when the number of balls or planes changes, or when some ball's path for the coming interval
 leaves its box or the sphere around its swept path. While a plane moves, the sphere–plane pairs are
-found again every step, from the kept boxes and the plane's sweep over the step.
+found again every step, from the kept boxes and the plane's sweep over the step; those of planes
+that stood still then and now are kept (``refresh_moving``).
 """
 
 from __future__ import annotations
@@ -42,6 +43,8 @@ class KeptPairs:
     plane: np.ndarray
     side: np.ndarray  # ±1: the side of the plane the ball is on
     counts: tuple[int, int]  # balls and planes in the world when the pairs were found
+    # (P,) the planes that stood still when their sphere–plane pairs were found (None: not known)
+    still: np.ndarray | None = None
     # lo, hi and centre as contiguous (3, N) columns for ``escaped``, made when first needed (``among``
     # hands them on with the boxes)
     _columns: tuple[np.ndarray, ...] | None = field(default=None, repr=False, compare=False)
@@ -152,7 +155,7 @@ class PairCache:
         if c is None or c.counts != counts or c.escaped(model, state, accel, dt):
             return self.renew(model, state, dt, BROAD_PHASE_STEPS * dt, accel, accel)
         if model.moving_planes():  # the planes moved since the pairs were found
-            c.sphere, c.plane = plane_pairs(model, state, c.lo, c.hi, dt)
+            refresh_moving(model, state, c, dt)
         c.side = plane_sides(model, state, c.sphere, c.plane)
         return c.among(self.awake)
 
@@ -161,6 +164,27 @@ class PairCache:
         """Find pairs afresh and keep them (they cover ``ahead`` seconds, so later steps reuse them)."""
         self.kept = find_pairs(model, state, h, ahead, accel, free)
         return self.kept.among(self.awake)
+
+
+def refresh_moving(model: Model, state: State, c: KeptPairs, h: float) -> None:
+    """Find again the sphere–plane pairs of ``c`` for the planes that move now or moved when their
+    pairs were found, from the kept boxes and each plane's sweep over ``h``.
+
+    The others stood still then and now, so finding theirs again from the same boxes would give the
+    same pairs; they are kept, and the result is the same pairs in the same order (plane by plane) as
+    finding every plane's again.
+    """
+    still = ~model.moving_plane_mask()
+    again = ~still if c.still is None else ~(still & c.still)
+    if again.all():
+        c.sphere, c.plane = plane_pairs(model, state, c.lo, c.hi, h)
+    else:
+        keep = ~again[c.plane]
+        s, p = plane_pairs(model, state, c.lo, c.hi, h, planes=np.flatnonzero(again))
+        sphere, plane = np.concatenate((c.sphere[keep], s)), np.concatenate((c.plane[keep], p))
+        order = np.argsort(plane, kind="stable")  # plane by plane, each plane's balls as found
+        c.sphere, c.plane = sphere[order], plane[order]
+    c.still = still
 
 
 def plane_sides(model: Model, state: State, sphere: np.ndarray, plane: np.ndarray) -> np.ndarray:
@@ -214,16 +238,18 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
     counts = (model.spheres.count, model.planes.count)
     sides = plane_sides(model, state, s, p)
-    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, _columns=(lo, hi, centre))
+    still = ~model.moving_plane_mask()
+    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, still=still, _columns=(lo, hi, centre))
 
 
-def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray,
-                h: float) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(sphere, plane) pairs whose boxes reach the plane, as it is or as it moves over ``h``."""
+def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray, h: float,
+                planes: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(sphere, plane) pairs whose boxes reach the plane, as it is or as it moves over ``h``, for the
+    ``planes`` given (all when None)."""
     pose, pl = state.planes, model.planes
     reach = None
     if model.moving_planes():
         reach = lambda p, distance: moving_planes.sweep(model, p, h, distance)  # noqa: E731
     return broadphase.sphere_plane_pairs(
-        lo, hi, pose.center, pose.normal, pose.axis_u, pose.axis_v, pl.half_size, reach
+        lo, hi, pose.center, pose.normal, pose.axis_u, pose.axis_v, pl.half_size, reach, planes
     )

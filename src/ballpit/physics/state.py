@@ -30,6 +30,21 @@ class Columns:
         self.count = 0
         self.capacity = capacity
         self._arrays = {k: np.zeros((capacity, *shape), dtype) for k, (shape, dtype) in spec.items()}
+        self._publish()
+
+    def _publish(self) -> None:
+        """Keep each array's live part as an attribute, so reading one costs a plain attribute lookup
+        (a step reads them some eighty times); done again whenever ``count`` or the arrays change."""
+        for k, array in self._arrays.items():
+            self.__dict__[k] = array[: self.count]
+
+    def __getstate__(self) -> dict:
+        """The columns without their live views (a copy makes its own from its own arrays)."""
+        return {k: v for k, v in self.__dict__.items() if k not in self._arrays}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._publish()
 
     def reserve(self, extra: int) -> slice:
         """Make room for ``extra`` more rows; returns the slice of the new rows."""
@@ -43,6 +58,7 @@ class Columns:
             self.capacity = capacity
         rows = slice(self.count, needed)
         self.count = needed
+        self._publish()
         return rows
 
     def full(self, name: str) -> np.ndarray:
@@ -142,4 +158,7 @@ class State:
 
 def with_static(rows: np.ndarray) -> np.ndarray:
     """Per-ball rows with the static world's zero row N appended (planes are body N in the solver)."""
-    return np.vstack((rows, np.zeros(rows.shape[1])))
+    out = np.empty((len(rows) + 1, rows.shape[1]))  # as np.vstack with a zero row, at a third of its cost
+    out[:-1] = rows
+    out[-1] = 0.0
+    return out

@@ -79,12 +79,12 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndar
     impact uses), touching ones included.
     """
     dt, model = step.dt, step.model
-    if len(c) == 0:  # nothing near anything (free flight): nothing can meet
+    many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
+    if len(c) == 0 or (not many and len(c) <= model.crowd_limit):  # too few pairs to be more meetings
         return None
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
-    many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
     if meetings <= (0 if many else model.crowd_limit):
         return None
     return speculative_reach(step, c, accel, dv, da)

@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import collision, moving_planes
+from . import collision, exact, moving_planes
 from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
 from .pairs import contact_slop
@@ -181,7 +181,7 @@ def earliest(model: Model, state: State, c: ContactPoints, apart: np.ndarray, x:
         on = np.flatnonzero(c.kind[apart] == SPHERE_PLANE)
         pl, k = model.planes, c.other[apart[on]]
         spin, rel = pl.angular_velocity[k], dv[on] - pl.velocity[k]  # v − v_p
-        w = rel - np.cross(spin, x[a[on]] - state.planes.center[k])
+        w = rel - exact.cross(spin, x[a[on]] - state.planes.center[k])
         norm = lambda q: np.sqrt(_dot(q, q))  # noqa: E731
         rate, accel = norm(spin), norm(da[on])
         speed = norm(rel) + accel * h  # |v − v_p| over the interval
