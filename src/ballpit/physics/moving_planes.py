@@ -162,7 +162,7 @@ def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows,
     the contact slop, where every step split at their little falls.
 
     The normal turns by Rodrigues' formula with each plane's cos(ω·h) and sin(ω·h) taken once per plane
-    from Python's ``math`` (a few planes, not balls).
+    from ``exact.sin_cos`` (a few planes, not balls).
     """
     pl = model.planes
     on_plane = c.kind == SPHERE_PLANE
@@ -173,7 +173,8 @@ def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows,
     plane, ball = c.other[on], c.a[on]
     spin = pl.angular_velocity[plane]
     rates = [math.sqrt(x * x + y * y + z * z) for x, y, z in pl.angular_velocity.tolist()]
-    cos, sin = (np.array([f(rate * h) for rate in rates])[plane, None] for f in (math.cos, math.sin))
+    sin_all, cos_all = exact.sin_cos(np.array(rates) * h)  # not math's: its bits depend on the CPU
+    sin, cos = sin_all[plane, None], cos_all[plane, None]
     axis = spin / np.array(rates)[plane, None]
     n = rows.normal[on]
     # Rodrigues: n·cos θ + (k × n)·sin θ + k·(k·n)·(1 − cos θ)
