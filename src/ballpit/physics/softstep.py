@@ -46,20 +46,18 @@ from .rows import ContactRows, contact_rows
 from .state import Q, V, W, X, with_static
 
 # Contact stiffness (Hz) and damping ratio of an overlap's soft spring, and the fastest it pushes
-# overlapping balls apart (m/s). The damping ratio and push speed are Box2D v3's defaults; contacts
-# with a plane take twice the stiffness (Box2D's static softness). The stiffness is twice Box2D's
-# 60 Hz, capped at half the substep rate (Box2D: a quarter): a soft contact rests at the overlap
-# s = F·(1/m_a + 1/m_b)/ω² its load F needs, and at 60 Hz the bottom of a pile seven balls deep
-# rests about 5 % of a radius into its neighbours. Deeper than SLOP, the moving apart by positions
-# after the substeps then fought the spring every frame (lifted, sank back) and the pile never
-# stood still; at 120 Hz (a quarter of the overlap) the same pile rests within 1 %. The heavy
-# damping (ζ = 10) keeps the stiffer spring from ringing.
-CONTACT_HERTZ = 120.0
-HERTZ_CAP = 0.5  # of the substep rate 1/h
+# overlapping balls apart (m/s): Box2D v3's defaults. The stiffness is capped at a quarter of the
+# substep rate; contacts with a plane take twice it (Box2D's static softness).
+CONTACT_HERTZ = 60.0
 DAMPING_RATIO = 10.0
 MAX_PUSH = 3.0
 # Overlaps up to this fraction of the smaller radius are left to the soft spring (which holds a
 # resting pile with some give); only deeper ones are moved apart by positions after the substeps.
+# A soft contact rests at the overlap its load F needs, s_eq = F·(1/m_a + 1/m_b)/ω² (ω = 2π·60 Hz:
+# about 5 % of a radius at the bottom of a 200-ball pile seven balls deep). Moved apart to less, the
+# spring would push less than the load, sink back and be moved apart again, every frame: a pile that
+# never stands still. So the spring remembers how far it was moved apart (``WarmStart.apart``, up to
+# s_eq) and keeps pushing as if that overlap were still there: it holds the load at the slop.
 SLOP = 0.01
 # Jacobi sweeps per substep: with the bias, then without it (relax). Friction and rolling resistance
 # are updated in the last sweep of each; the others update the normal impulses alone.
@@ -163,7 +161,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     on_plane = rows.b == n_balls
     # the surface's own speed along the normal (moving planes), to move their side of s
     surface_n = _dot(k.surface, n) if k.moving else None
-    hertz = min(CONTACT_HERTZ, HERTZ_CAP / h)
+    hertz = min(CONTACT_HERTZ, 0.25 / h)
     ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
     bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
     mass_scale = np.where(on_plane, plane_soft.mass_scale, ball_soft.mass_scale)
@@ -172,6 +170,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
 
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
+    apart = warm.apart_of(keys)
     normal = imp.normal.copy()
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
     push = np.zeros((6, 2 * kc))
@@ -193,7 +192,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # the contacts that can push this substep: pressed already, or closing faster than their gap
         k.share_among((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
         speculative = s > 0.0
-        target = np.where(speculative, -s / h, np.minimum(-bias_rate * s, MAX_PUSH))
+        target = np.where(speculative, -s / h, np.minimum(-bias_rate * (s - apart), MAX_PUSH))
         scale = np.where(speculative, 1.0, mass_scale)
         keep = np.where(speculative, 0.0, impulse_scale)
         normal, tangential = _sweeps(
@@ -246,6 +245,13 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
                    out=least)  # fmt: skip
         body[:, X] = new
     _out_of_planes(model, state, c, rows, least, x0, idx, dt)
+    # what the springs hold apart for the next frame: the moving apart by positions, up to the overlap
+    # each contact's load needs, s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))
+    x[:, live] = body[idx, X].T
+    s_end = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
+    s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
+    held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
+    warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
     return Frame(balls, total, least, farthest, largest, lo, hi)
 
 

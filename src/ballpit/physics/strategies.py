@@ -251,7 +251,7 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
     body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
-    warm_before = (step.warm.keys, step.warm.forces)
+    warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
     kept_before = step.pairs.kept
     with step.profile.stage("soft step"):
         frame = softstep.frame(model, state, c, step.forces, dt, step.threshold, step.warm, substeps)
@@ -273,7 +273,7 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         return frame
     state.body[:] = body_before  # undo it all
     state.planes = planes_before
-    step.warm.keys, step.warm.forces = warm_before
+    step.warm.keys, step.warm.forces, step.warm.apart = warm_before
     step.pairs.kept = kept_before
     return None
 
