@@ -123,6 +123,34 @@ def test_a_settled_pile_rests_below_a_millimetre_per_second_without_creeping():
     assert np.abs(world.spheres.positions - start).max() < 1e-3
 
 
+def test_columns_eight_balls_tall_stand_still_without_sinking_into_each_other():
+    # 288 balls stacked in 36 straight columns, eight deep, wall to wall: the bottom contacts carry
+    # seven balls' weight. A soft contact rests at the overlap its load needs, F·(1/m_a + 1/m_b)/ω²
+    # (2 % of a radius here at 60 Hz), deeper than the slop the soft step moves apart by positions;
+    # moved apart, the spring must keep holding the load, or the columns sink back and are moved apart
+    # again every step (they jittered at 7 mm/s); a stiffer spring rang instead.
+    world = ballpit.World()
+    world.add_plane(normal=(0, 1, 0), friction=0.5, rolling_friction=0.05, restitution=0.3)
+    for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
+        world.add_plane(position=np.multiply(normal, -0.3), normal=normal, friction=0.5, restitution=0.3)
+    r = 0.05
+    ix, iy, iz = (a.ravel() for a in np.meshgrid(np.arange(6), np.arange(8), np.arange(6), indexing="ij"))
+    world.add_spheres(np.column_stack(((ix - 2.5) * 0.1, 0.051 + iy * 0.101, (iz - 2.5) * 0.1)), radius=r,
+                      restitution=0.5, rolling_friction=0.05)  # fmt: skip
+    for _ in range(480):
+        world.step(1 / 240)
+    fastest = 0.0
+    for _ in range(120):
+        world.step(1 / 240)
+        fastest = max(fastest, float(np.linalg.norm(world.spheres.velocities, axis=1).max()))
+    assert world.crowded_steps == 600  # every step a soft frame
+    assert fastest < 1e-3
+    x = world.spheres.positions
+    d = np.linalg.norm(x[:, None] - x[None], axis=2) + np.eye(len(x)) * 1e9
+    assert (2 * r - d).max() < 0.02 * r
+    assert x[:, 1].min() > r - 0.02 * r
+
+
 @pytest.mark.parametrize("integrator", ["rk4", "rk2"])
 def test_a_soft_step_in_a_closed_elastic_frictionless_box_never_gains_energy(integrator):
     # 125 balls at rest in a 2 m box (e = 1, μ = 0) fall and bounce under gravity. Every step with an
