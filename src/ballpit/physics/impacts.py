@@ -126,40 +126,6 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     events.add(now, hit, hit.keys(), imp.normal * scale)
 
 
-def bounce(model: Model, state: State, c: ContactPoints, rows: ContactRows, restitution_threshold: float,
-           min_normal_speed: np.ndarray, events: EventLog, now: float, *, arrivals_only: bool,
-           seeds_among: np.ndarray | None = None, jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
-    """The crowded step's bounce (until it calls ``in_waves``): the contacts that arrive bounce
-    together with their whole island, each from the approach speed it had before any of them did.
-
-    This is the rule that moves a touching cradle on as one block; the split step no longer uses it.
-    ``min_normal_speed`` is as in ``in_waves``. With ``arrivals_only`` only arrivals faster than the
-    restitution threshold start an island; otherwise any approach does (and the slow ones in it just
-    stop). ``seeds_among``, when given, is where islands may start (other contacts only join them).
-    """
-    if len(c) == 0:
-        return
-    v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
-    vn = np.einsum("ij,ij->i", _relative_velocity(c, rows, v, w), c.normal)
-    approaching = vn < min_normal_speed - APPROACH_SPEED
-    arriving = approaching & (-vn > restitution_threshold)
-    seeds = arriving if arrivals_only else approaching
-    if seeds_among is not None:
-        seeds = seeds & seeds_among
-    if not seeds.any():
-        return
-    near = _island(model, c, seeds)
-    island = rows.subset(near)
-    target = np.where(arriving[near], -island.restitution * vn[near], min_normal_speed[near])
-    imp = solver.solve(island, v, w, target, Impulses.zeros(len(island)), model.solver_iterations,
-                       jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
-    body = state.body
-    body[:, V] = v[:-1]
-    body[:, W] = w[:-1]
-    hit = c.subset(near)
-    events.add(now, hit, hit.keys(), imp.normal)
-
-
 def _relative_velocity(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Each contact point's velocity of a relative to b (to a moving plane's surface), (K, 3)."""
     va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))

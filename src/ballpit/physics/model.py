@@ -77,6 +77,7 @@ class Model:
         self.solver_iterations = SOLVER_ITERATIONS
         self.crowd_limit: float = CROWD_LIMIT
         self.sleep = False  # whether still islands fall asleep (sleeping.py)
+        self.substeps = 1  # soft substeps of a crowded step (softstep.py)
 
     def append_spheres(self, n: int, *, radius, mass, restitution, friction, rolling_friction,
                        hollow) -> slice:  # fmt: skip

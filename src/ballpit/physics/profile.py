@@ -18,6 +18,7 @@ STAGES = (
     "penetration",
     "impacts",
     "resting solve",
+    "soft step",
     "time of impact",
     "integrate",
     "sleep",

@@ -28,6 +28,8 @@ class WarmStart:
     def __init__(self) -> None:
         self.keys = np.zeros(0, np.int64)
         self.forces = Impulses.zeros(0)
+        # per kept pair, how far a soft step's spring holds it apart beyond its overlap (softstep.py)
+        self.apart = np.zeros(0)
 
     def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""
@@ -53,6 +55,21 @@ class WarmStart:
         self.keys = keys[order]
         parts = (imp.normal, imp.friction, imp.rolling)
         self.forces = Impulses(*(part[order] / h for part in parts))
+        self.apart = np.zeros(len(keys))
+
+    def apart_of(self, keys: np.ndarray) -> np.ndarray:
+        """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept)."""
+        held = np.zeros(len(keys))
+        if len(self.keys) == 0:
+            return held
+        pos = np.minimum(np.searchsorted(self.keys, keys), len(self.keys) - 1)
+        found = self.keys[pos] == keys
+        held[found] = self.apart[pos[found]]
+        return held
+
+    def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
+        """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
+        self.apart = apart[np.argsort(keys)]
 
 
 def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,

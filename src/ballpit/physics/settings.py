@@ -46,16 +46,51 @@ ESCAPE_CHUNK = 8192
 # --- Crowded steps (strategies.py) ------------------------------------------------------------------
 
 # Default of ``World.crowd_limit``: a step in which more than this many pairs not yet touching may meet
-# is taken whole, with speculative contacts.
+# is crowded (taken as a soft-step frame, softstep.py).
 CROWD_LIMIT = 32
 # Splitting a step costs a pass over every contact per impact: with this many kept pairs or more, any
-# meeting makes the step crowded (a pile, not a textbook scene).
+# meeting (or touching contact) makes the step crowded (a pile, not a textbook scene).
 CROWD_PAIRS = 256
+# A contact overlapping by more than this fraction of its ball's radius makes the step crowded: the
+# soft step pushes such balls apart with its planes holding, instead of jumping them apart by positions.
+CROWD_OVERLAP = 0.02
 # The pairs of a crowded step are those within this many times the distance they could close.
 SPECULATIVE_REACH = 2.0
-# In a crowded step, a pair left out of the speculative contacts that would overlap by more than this
-# fraction of the smaller radius cuts the step short at its impact.
-UNGUARDED_OVERLAP = 0.05
+# A crowded step is taken as soft substeps only while no ball it moves travels more than this fraction
+# of its radius in one substep (before, by its speed and acceleration; after, as it moved): beyond it a
+# substep could carry a ball past a contact it never measured.
+SUBSTEP_TRAVEL = 1.0
+# A frame the soft step cannot hold is tried again with twice the substeps, at most this many times,
+# before the step is split at impacts.
+RETRIES = 2
+# ... and while no pair overlaps by more than this fraction of the smaller radius (25 %: well short of
+# passing through, and deep enough that a landing pile's transient overlaps do not undo frames).
+DEEP_OVERLAP = 0.25
+
+# --- The soft step of a crowded step (softstep.py) -------------------------------------------------
+
+# Contact stiffness (Hz) and damping ratio of an overlap's soft spring, and the fastest it pushes
+# overlapping balls apart (m/s): Box2D v3's defaults. The stiffness is capped at a quarter of the
+# substep rate; contacts with a plane take twice it (Box2D's static softness).
+CONTACT_HERTZ = 60.0
+DAMPING_RATIO = 10.0
+MAX_PUSH = 3.0
+# Overlaps up to this fraction of the smaller radius are left to the soft spring (which holds a
+# resting pile with some give); only deeper ones are moved apart by positions after the substeps.
+# A soft contact rests at the overlap its load F needs, s_eq = F·(1/m_a + 1/m_b)/ω² (ω = 2π·60 Hz:
+# about 5 % of a radius at the bottom of a 200-ball pile seven balls deep). Moved apart to less, the
+# spring would push less than the load, sink back and be moved apart again, every frame: a pile that
+# never stands still. So the spring remembers how far it was moved apart (``WarmStart.apart``, up to
+# s_eq) and keeps pushing as if that overlap were still there: it holds the load at the slop.
+SLOP = 0.01
+# Jacobi sweeps per substep: with the bias, then without it (relax). Friction and rolling resistance
+# are updated in the last sweep of each; the others update the normal impulses alone.
+SOLVE_SWEEPS = 4
+RELAX_SWEEPS = 2
+# Jacobi sweeps that move apart, by positions, the overlaps deeper than SLOP the substeps left.
+SEPARATE_SWEEPS = 16
+# Jacobi sweeps of the restitution pass (normal impulses only).
+RESTITUTION_SWEEPS = 4
 
 # --- Time of impact (toi.py) ------------------------------------------------------------------------
 

@@ -4,10 +4,12 @@
   Each interval finds the contacts, pushes overlapping balls apart, bounces the ones that arrive,
   solves the resting contacts for constant forces over the rest of the step, predicts the next
   impact and integrates to it. This is what gives e²·h apexes at 60 Hz and Newton's cradle.
-- ``whole_with_speculative_contacts``: when many pairs may meet within one step (a pile landing),
-  splitting it at each impact costs a pass over the world per impact. The step is taken whole instead
-  (P. Firth, "Speculative contacts", 2011; as in Box2D v3 and Bullet): every pair that could meet
-  joins the solves as a contact with a gap, which may close by at most that gap, v_n ≥ −gap/dt.
+- ``crowded_step``: when many pairs may meet within one step (a pile landing or resting), splitting
+  it at each impact costs a pass over the world per impact. The step is one frame of Box2D v3's soft
+  step instead (softstep.py): contacts measured once, with a speculative margin (P. Firth,
+  "Speculative contacts", 2011), then ``substeps`` soft-biased solves. Where it cannot keep the walls
+  (balls too fast for a substep, or something it did not foresee) it is retried with more substeps
+  and, failing that, split at impacts.
 
 ``crowded_contacts`` decides between them. Each strategy passes the restitution threshold and each
 contact's minimum normal speed (v_n ≥ min_normal_speed: 0 touching, −gap/dt speculative) to the
@@ -16,11 +18,12 @@ stages explicitly.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import impacts, moving_planes, narrowphase, penetration, resting, rows, toi
+from . import collision, impacts, moving_planes, narrowphase, penetration, resting, rows, softstep, toi
 from .contacts import SPHERE_PLANE, ContactPoints, EventLog
 from .forces import ConstantPerBall, ForceTerm, free_acceleration
 from .integrators import Workspace, integrate
@@ -30,12 +33,17 @@ from .profile import StepProfile
 from .settings import (
     BROAD_PHASE_STEPS,
     CONTACT_SLOP,
+    CROWD_OVERLAP,
     CROWD_PAIRS,
+    DEEP_OVERLAP,
     MAX_INTERVALS,
+    RETRIES,
     SPECULATIVE_REACH,
-    UNGUARDED_OVERLAP,
+    SUBSTEP_TRAVEL,
 )
-from .state import State, V, W, with_static
+from .state import State, V, W, X, with_static
+
+DEEPER = "a contact overlapped deeper than DEEP_OVERLAP (more than it did)"
 
 
 @dataclass
@@ -58,6 +66,7 @@ class Step:
     events: EventLog
     profile: StepProfile
     intervals: int = 0
+    doubt: str | None = None  # why a soft frame was undone and split at impacts instead (crowded_step)
 
     def integrate(self, push: ForceTerm | None, h: float) -> None:
         """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``, and move
@@ -79,14 +88,22 @@ def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndar
     impact uses), touching ones included.
     """
     dt, model = step.dt, step.model
+    if len(c) == 0:  # nothing near anything (free flight): nothing can meet
+        return None
     many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
-    if len(c) == 0 or (not many and len(c) <= model.crowd_limit):  # too few pairs to be more meetings
+    # balls overlapping deeply (created at one point, or left so by a crowd) are pushed apart by the
+    # soft step, whose planes hold, not jumped apart by positions
+    deep = model.crowd_limit != np.inf and (c.gap < -CROWD_OVERLAP * model.spheres.radius[c.a]).any()
+    if not many and len(c) <= model.crowd_limit and not deep:  # too few pairs to be more meetings
         return None
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
-    if meetings <= (0 if many else model.crowd_limit):
-        return None
+    # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
+    # soft step it landed in, not alternately in the two
+    if meetings <= (0 if many else model.crowd_limit) and not (many and (c.gap < CONTACT_SLOP).any()):
+        if not deep:
+            return None
     return speculative_reach(step, c, accel, dv, da)
 
 
@@ -185,71 +202,160 @@ def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPer
     step.integrate(hold, remaining)
 
 
-def whole_with_speculative_contacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
-                                    solved: np.ndarray) -> None:  # fmt: skip
-    """The whole step as one interval, with speculative contacts: those of ``contacts`` (all the kept
-    ``pairs`` measured now) where ``solved`` holds (from ``crowded_contacts``).
+def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: np.ndarray,
+                 accel: tuple[np.ndarray, np.ndarray]) -> bool:  # fmt: skip
+    """A crowded step as one frame of ``model.substeps`` soft substeps (softstep.py) over the contacts
+    of ``contacts`` where ``solved`` holds; True when it was taken so.
 
-    A contact with a gap may close by at most that gap: its minimum normal speed is −gap/dt, and the
-    constraint only pushes if the pair would otherwise pass it. A pair arriving faster than the
-    restitution threshold leaves at e times its approach speed, as in a split step, but from where it
-    was when the step began: a bounce is early by at most the gap it had left (≤ v·dt). Slower
-    approaches start no bounce island; the resting forces stop them within the step.
+    The soft step keeps the walls only while every ball it moves travels less than SUBSTEP_TRAVEL of
+    its radius per substep, and while nothing it did not foresee happens. A frame is tried with twice
+    the substeps (at most RETRIES times) when some ball could travel farther before it starts, or
+    when it is undone after it because:
 
-    A bounce can turn a ball towards a body it was not near, whose pair is not among ``c``. Before
-    moving, every such pair is followed along the new paths; if one would overlap by more than
-    UNGUARDED_OVERLAP of a radius within the step, the step goes only as far as its impact and the rest
-    of it is split at impacts. So nothing passes through a plane or a ball, however hard it was hit;
-    shallower overlaps are removed at the next step's start.
+    - a ball moved farther than that in a substep, or left the box its pairs were found from (then a
+      pair the broad phase never saw could have met);
+    - a solved contact overlapped deeper than DEEP_OVERLAP of the smaller radius at any substep's end;
+    - a pair left out of the contacts that could have met overlaps that deep at the end.
+
+    When no try holds, the step is split at impacts instead (``split_at_impacts``, which passes
+    through nothing, however fast).
     """
-    model, state, prof, dt, now = step.model, step.state, step.profile, step.dt, step.state.time
+    model, state, dt, now = step.model, step.state, step.dt, step.state.time
+    free, _ = accel
+    solved = solved | (contacts.kind == SPHERE_PLANE)  # every kept pair with a plane: planes hold
     c = contacts.subset(solved)
-    min_normal_speed = np.where(c.gap < CONTACT_SLOP, 0.0, -c.gap / dt)  # each may close by its gap (m/s)
-    with prof.stage("contact rows"):
-        batch = rows.contact_rows(model, state, c)
-    with prof.stage("penetration"):
-        penetration.remove_penetration(model, state, c, batch)
-    with prof.stage("impacts"):
-        impacts.bounce(model, state, c, batch, step.restitution_threshold, min_normal_speed, step.events, now,
-                       arrivals_only=True, jacobi_from=0)  # fmt: skip
-    free, ang = free_acceleration(state.body, step.forces)
-    # The bounces turned some balls towards neighbours they were not closing on before: those pairs
-    # join the speculative contacts, and bounce in turn if they now arrive.
-    with prof.stage("crowd test"):
-        joined = speculative_reach(step, contacts, free) & ~solved
-    if joined.any():
-        solved = solved | joined
-        new = np.r_[np.zeros(len(c), bool), np.ones(np.count_nonzero(joined), bool)]
-        c = ContactPoints.concatenate([c, contacts.subset(joined)])
-        min_normal_speed = np.where(c.gap < CONTACT_SLOP, 0.0, -c.gap / dt)
-        with prof.stage("contact rows"):
-            batch = rows.contact_rows(model, state, c)
-        # Only the joined pairs start islands: a contact the first pass bounced and that still closes
-        # is caught between neighbours bouncing too, and the resting solve stops it.
-        with prof.stage("impacts"):
-            impacts.bounce(model, state, c, batch, step.restitution_threshold, min_normal_speed,
-                           step.events, now, arrivals_only=True, seeds_among=new, jacobi_from=0)  # fmt: skip
-        free, ang = free_acceleration(state.body, step.forces)
-    with prof.stage("resting solve"):
-        push = resting.resting_forces(model, state, c, batch, free, ang, dt, dt, min_normal_speed,
-                                      step.warm, step.events, now, jacobi_from=0)  # fmt: skip
-    lin = free if push is None else free + push.lin
-    with prof.stage("pairs"):
-        if pairs.escaped(model, state, lin, dt):
-            pairs = step.pairs.renew(model, state, dt, BROAD_PHASE_STEPS * dt, lin, free)
-            contacts = narrowphase.contact_points(model, state, pairs)
-            solved = np.isin(contacts.keys(), c.keys())
-        else:  # the same pairs, where penetration removal left them
-            contacts = narrowphase.contact_points(model, state, pairs)
-        unguarded = contacts.subset(~solved)
-    with prof.stage("time of impact"):
-        deep = toi.deep_overlaps(model, state, unguarded, lin, dt, UNGUARDED_OVERLAP)
-        h = toi.next_impact(model, state, unguarded.subset(deep), lin, dt) if deep.any() else np.inf
-    if h >= dt:
-        step.integrate(push, dt)
-        step.events.close_interval(1.0)
-        return
-    step.integrate(push, h)
-    step.events.close_interval(h / dt)
-    # the rest of the step, split at impacts (its first interval measures the contacts afresh)
-    split_at_impacts(step, contacts, pairs, (free, ang), elapsed=h)
+    radius = np.append(model.spheres.radius, np.inf)
+    v = with_static(state.body[:, V])
+    acc = with_static(free)
+    speed = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
+    for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
+        h = dt / substeps
+        fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
+        if fast[c.a].any() or fast[c.b].any():
+            step.doubt = "a ball could travel farther than SUBSTEP_TRAVEL radii in a substep"
+            continue
+        last = substeps == model.substeps << RETRIES
+        frame = _soft_frame(step, contacts, solved, c, accel, substeps, last)
+        if frame is not None:
+            break
+    else:
+        return False
+    step.events.add(now, c, c.keys(), frame.impulse)
+    step.intervals += 1
+    return True
+
+
+def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
+                accel: tuple[np.ndarray, np.ndarray], substeps: int,
+                last: bool) -> softstep.Frame | None:  # fmt: skip
+    """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone,
+    the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted. The ``last`` try is
+    kept when its only fault is a solved contact that overlapped deeper: that is no pass through
+    anything, and splitting a heap of overlapping balls at impacts jumps them apart by positions."""
+    model, state, dt = step.model, step.state, step.dt
+    n = model.spheres.count
+    body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
+    warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
+    kept_before = step.pairs.kept
+    with step.profile.stage("soft step"):
+        frame = softstep.frame(
+            model, state, c, step.forces, dt, step.restitution_threshold, step.warm, substeps
+        )
+        balls = frame.balls[frame.balls < n]
+        others = np.ones(n, bool)
+        others[balls] = False
+        if not model.moving_planes():  # then nothing does work on the balls but gravity
+            softstep.hold_energy(model, state, body_before, balls)
+    if others.any():  # balls touching nothing this frame fly on the world's integrator
+        with step.profile.stage("integrate"):
+            rows = state.body[others]
+            terms = softstep.compact_terms(step.forces, np.flatnonzero(others), n)
+            integrate(model.integrator, rows, terms, dt, step.workspace)
+            state.body[others] = rows
+    moving_planes.advance(model, state, dt)
+    with step.profile.stage("time of impact"):
+        step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before, substeps)
+    if step.doubt is None or (last and step.doubt == DEEPER):
+        return frame
+    state.body[:] = body_before  # undo it all
+    state.planes = planes_before
+    step.warm.keys, step.warm.forces, step.warm.apart = warm_before
+    step.pairs.kept = kept_before
+    return None
+
+
+def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
+                frame: softstep.Frame, before: np.ndarray, substeps: int) -> str | None:  # fmt: skip
+    """Why a soft frame cannot be trusted (see ``crowded_step``), or None when it kept its promises.
+
+    A ball that left the box its pairs were found from may have met a body the broad phase never
+    paired it with: the pairs are then found afresh around where the balls are now (they replace the
+    kept pairs, as a split step's renewal does) and those new pairs are checked too."""
+    model, state = step.model, step.state
+    n = model.spheres.count
+    radius = model.spheres.radius
+    cols = frame.balls < n
+    balls = frame.balls[cols]
+    r = radius[balls]
+    if (frame.largest_move[cols] > SUBSTEP_TRAVEL * r).any():
+        return "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
+    smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
+    if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
+        return DEEPER
+    # how far each ball got from where it started (the others flew straight)
+    far = np.zeros(n + 1)
+    moved = state.body[:, X] - before[:, X]
+    far[:n] = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2 + moved[:, 2] ** 2)
+    far[balls] = np.maximum(far[balls], frame.farthest[cols])
+    kept = step.pairs.kept
+    lo, hi = frame.lo, frame.hi
+    centre = kept.centre[balls].T
+    corner = np.maximum(np.abs(lo - centre), np.abs(hi - centre))
+    escaped = (
+        (lo - r < kept.lo[balls].T).any()
+        or (hi + r > kept.hi[balls].T).any()
+        or (np.sqrt(corner[0] ** 2 + corner[1] ** 2 + corner[2] ** 2) + r > kept.reach[balls]).any()
+    )
+    if escaped:  # pairs around where the balls are now; those not solved are the ones left out
+        free, _ = free_acceleration(state.body, step.forces)
+        pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free)
+        now = narrowphase.contact_points(model, state, pairs)
+        out = now.subset(~np.isin(now.keys(), c.keys()))
+        out.gap = _gap_from(out, before, model, state)
+    else:
+        out = contacts.subset(~solved)
+        near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
+        out = out.subset(near)
+        start = np.minimum(out.gap, 0.0)
+        out.gap = _gap_from(out, before, model, state) - start
+    if len(out) == 0:
+        return None
+    on_plane = out.kind == SPHERE_PLANE
+    smaller = np.where(
+        on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
+    )
+    if (out.gap < -DEEP_OVERLAP * smaller).any():
+        return "a pair left out overlaps deeper than DEEP_OVERLAP"
+    return None
+
+
+def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) -> np.ndarray:
+    """The gaps of the pairs ``c`` now, each ball kept on the side of a plane it started the step on
+    (``before``): a ball that crossed a plane overlaps it by its whole crossing."""
+    gap = np.empty(len(c))
+    if len(c) == 0:
+        return gap
+    x, radius = state.body[:, X], model.spheres.radius
+    on_plane = c.kind == SPHERE_PLANE
+    if on_plane.any():
+        pose = state.planes
+        s, p = c.a[on_plane], c.other[on_plane]
+        d = before[s, 0:3] - pose.center[p]
+        nrm = pose.normal[p]
+        side = np.where(d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2] < 0.0, -1.0, 1.0)
+        gap[on_plane] = collision.sphere_plane(x, radius, s, p, side, pose.center, pose.normal, pose.axis_u,
+                                               pose.axis_v, model.planes.half_size)[0]  # fmt: skip
+    if (~on_plane).any():
+        gap[~on_plane] = collision.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
+    return gap

@@ -60,6 +60,7 @@ class World:
         angular_drag: float = 0.0,
         restitution_threshold: float | None = None,
         sleep: bool = False,
+        substeps: int = 1,
     ) -> None:
         self.model = Model()
         self.state = State()
@@ -69,7 +70,8 @@ class World:
         self.angular_drag = angular_drag
         self.restitution_threshold = restitution_threshold
         self.sleep = sleep
-        self.crowded_steps = 0  # how many steps were taken whole, with speculative contacts
+        self.substeps = substeps
+        self.crowded_steps = 0  # how many steps were taken as soft substeps (crowded)
         self.profile = StepProfile()  # the last step's time per stage (profile.py)
         self._pairs = PairCache()
         self._warm = WarmStart()
@@ -124,6 +126,18 @@ class World:
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
             raise ValueError(f"solver_iterations must be a whole number of at least 1, got {value!r}")
         self.model.solver_iterations = int(value)
+
+    @property
+    def substeps(self) -> int:
+        """Soft substeps per crowded step (Box2D v3's soft step, softstep.py): a crowded step's contacts
+        are solved this many times, each over dt / substeps. The split-at-impacts path ignores it."""
+        return self.model.substeps
+
+    @substeps.setter
+    def substeps(self, value: int) -> None:
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise ValueError(f"substeps must be a whole number of at least 1, got {value!r}")
+        self.model.substeps = int(value)
 
     crowd_limit = _model_number(
         "crowd_limit",
@@ -284,7 +298,7 @@ class World:
         Stages: waking what was changed by hand (sleeping.py), the kept pairs (found again only when
         a path leaves its box), the narrow phase, waking the islands awake balls reach, the crowd
         test, then one of the two strategies (strategies.py): split the step at every impact, or take
-        a crowded step whole with speculative contacts; last, still islands fall asleep. ``profile``
+        a crowded step as soft substeps (softstep.py); last, still islands fall asleep. ``profile``
         then holds the step's time per stage.
         """
         dt = validation.number("dt", dt, positive=True)
@@ -323,11 +337,10 @@ class World:
                     reach = strategies.speculative_reach(step, contacts, unheld)
         with prof.stage("crowd test"):
             crowd = strategies.crowded_contacts(step, contacts, free)
-        if crowd is None:
-            strategies.split_at_impacts(step, contacts, pairs, (free, ang))
-        else:
-            strategies.whole_with_speculative_contacts(step, contacts, pairs, crowd)
+        if crowd is not None and strategies.crowded_step(step, contacts, pairs, crowd, (free, ang)):
             self.crowded_steps += 1
+        else:
+            strategies.split_at_impacts(step, contacts, pairs, (free, ang))
         if model.sleep:
             with prof.stage("sleep"):
                 sleeping.after_step(model, state, sleep, contacts, reach, dt)

@@ -77,6 +77,7 @@ class Builder:
                 "restitution_threshold", d["restitution_threshold"], nonnegative=True
             ),
             sleep=e.boolean("sleep", bool(d["sleep"])),
+            substeps=e.integer("substeps", int(d["substeps"]), minimum=1),
         )
         self.overlap_tolerance = e.number("overlap_tolerance", schema.OVERLAP_TOLERANCE, nonnegative=True)
         return params, timestep, e.number("duration", None, positive=True)

@@ -23,7 +23,7 @@ def _defaults(function: Callable, names: tuple[str, ...]) -> dict[str, object]:
 # What the [world] table passes to World(...), and its defaults there.
 WORLD_DEFAULTS = _defaults(
     World.__init__,
-    ("gravity", "integrator", "linear_drag", "angular_drag", "restitution_threshold", "sleep"),
+    ("gravity", "integrator", "linear_drag", "angular_drag", "restitution_threshold", "sleep", "substeps"),
 )
 TIMESTEP_DEFAULT = DEFAULT_TIMESTEP  # s per physics step, when [world] gives no timestep
 INTEGRATORS = INTEGRATOR_NAMES
@@ -80,6 +80,7 @@ WORLD_KEYS = (
     "angular_drag",
     "restitution_threshold",
     "sleep",
+    "substeps",
     "duration",
     "overlap_tolerance",
 )

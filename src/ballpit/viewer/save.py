@@ -126,6 +126,8 @@ def _world_table(world: object, timestep: float, sc: Scales) -> Table:
         table["restitution_threshold"] = float(world.restitution_threshold)  # type: ignore[attr-defined]
     if world.sleep:  # type: ignore[attr-defined]
         table["sleep"] = True
+    if world.substeps != 1:  # type: ignore[attr-defined]
+        table["substeps"] = int(world.substeps)  # type: ignore[attr-defined]
     return table
 
 
@@ -208,8 +210,11 @@ def scene_document(
     sc = Scales.of(world, camera)
     if "world" not in doc:
         doc.append("world", _world_table(world, sim.timestep, sc))
-    elif doc["world"].get("integrator", "rk4") != world.integrator:
-        _set(doc["world"], "integrator", world.integrator)
+    else:
+        if doc["world"].get("integrator", "rk4") != world.integrator:
+            _set(doc["world"], "integrator", world.integrator)
+        if doc["world"].get("substeps", 1) != world.substeps:
+            _set(doc["world"], "substeps", int(world.substeps))
 
     look_distance = float(np.linalg.norm(look.camera_look_at - look.camera_position)) or 10.0
     view = doc["camera"] if "camera" in doc else tomlkit.table()

@@ -1,0 +1,498 @@
+"""The crowded step as a frame of substeps: Box2D v3's soft step (E. Catto, "Solver2D", 2024;
+Box2D v3 ``solver.c``, ``contact_solver.c``).
+
+Once per frame (one ``World.step``) the speculative contacts are measured and their rows built
+(anchors, effective masses, mixed materials, the relative normal velocity at the frame's start). Then
+``substeps`` times, with h = dt / substeps:
+
+1. integrate velocities: v += a·h under the force terms (gravity, drag);
+2. warm start: apply the accumulated impulses again;
+3. solve with a soft bias (below);
+4. integrate positions: x += v·h (symplectic Euler, as Box2D: a ball held by a contact moves exactly
+   as the solve leaves its velocity, so a resting ball stays put);
+5. relax: solve again without the bias, so the push-out moves positions but leaves no velocity.
+
+A contact's separation inside the frame is the one measured at its start plus the balls' moved
+positions along the normal, s = s₀ + n·(Δx_a − Δx_b), not a new narrow phase. A contact with s > 0 is
+speculative: it may close by at most s this substep, v_n ≥ −s/h. One that overlaps is a soft spring
+(Catto, "Soft constraints", GDC 2011): with ω = 2π·f, ζ the damping ratio,
+
+    a₁ = 2ζ + h·ω,  a₂ = h·ω·a₁,  a₃ = 1/(1 + a₂)
+    bias rate = ω/a₁,  mass scale = a₂·a₃,  impulse scale = a₃
+    ΔP = m_n·(mass scale)·(target − v_n) − (impulse scale)·P,  target = min(−(bias rate)·s, MAX_PUSH)
+
+After the last substep one restitution pass (``restitution_pass``) bounces the contacts that closed
+faster than the threshold at the frame's start, and the impulses are kept for the next frame's warm
+start. Balls that touch no contact of the frame are left to the world's integrator (free flight keeps
+its textbook accuracy); see ``strategies.crowded_step`` for when a frame is taken this way at all and
+how its result is checked.
+
+Every sweep updates all contacts at once (projected Jacobi with mass splitting, ``jacobi.py``): a
+substep costs a fixed number of array passes, however many colours a pile would need.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import jacobi, penetration, quaternion
+from .contacts import ContactPoints
+from .forces import ConstantPerBall, ForceTerm, constant_acceleration
+from .impulses import Impulses
+from .rows import ContactRows, contact_rows
+from .settings import (
+    CONTACT_HERTZ,
+    DAMPING_RATIO,
+    MAX_PUSH,
+    RELAX_SWEEPS,
+    RESTITUTION_SWEEPS,
+    SEPARATE_SWEEPS,
+    SLOP,
+    SOLVE_SWEEPS,
+)
+from .state import Q, V, W, X, with_static
+
+
+class _Rows(jacobi._Contacts):
+    """The frame's contacts as the Jacobi sweeps take them (``jacobi._Contacts``), with each ball's
+    mass split only among its contacts that can push this substep (``share``): a speculative contact
+    still far from closing takes no share, so it does not soften the ones that carry the load."""
+
+    def __init__(self, rows: ContactRows) -> None:
+        super().__init__(rows)
+        self.ima, self.imb = rows.inv_mass_a, rows.inv_mass_b
+        self.iia, self.iib = rows.inv_inertia_a, rows.inv_inertia_b
+        ra, rb = -self.minus_ra, -self.minus_rb
+        self.ra2, self.rb2 = ra * ra, rb * rb
+        self.whole = self.ima + self.imb  # 1/m_n of the unsplit balls
+
+    def share_among(self, active: np.ndarray) -> None:
+        """Split each ball's mass among its ``active`` contacts (at least one share each)."""
+        k = self.k
+        counts = np.bincount(self.ends, weights=np.concatenate((active, active)), minlength=self.m)
+        share = np.maximum(counts, 1.0)
+        sa, sb = share[self.ends[:k]], share[self.ends[k:]]
+        self.m_n = 1.0 / (sa * self.ima + sb * self.imb)
+        m_t = 1.0 / (sa * (self.ima + self.ra2 * self.iia) + sb * (self.imb + self.rb2 * self.iib))
+        m_r = 1.0 / np.maximum(sa * self.iia + sb * self.iib, 1e-300)
+        self.m_tr = np.stack((m_t, m_r))[:, None, :]
+
+
+@dataclass(frozen=True)
+class Softness:
+    """A soft constraint's coefficients for a substep h (see the module docstring)."""
+
+    bias_rate: float
+    mass_scale: float
+    impulse_scale: float
+
+
+def softness(hertz: float, zeta: float, h: float) -> Softness:
+    """Box2D's ``b2MakeSoft``: the spring of frequency ``hertz`` and damping ratio ``zeta`` over h."""
+    if hertz == 0.0:
+        return Softness(0.0, 1.0, 0.0)
+    omega = 2.0 * math.pi * hertz
+    a1 = 2.0 * zeta + h * omega
+    a2 = h * omega * a1
+    a3 = 1.0 / (1.0 + a2)
+    return Softness(omega / a1, a2 * a3, a3)
+
+
+@dataclass
+class Frame:
+    """What a soft frame leaves for the checks and the record: per contact the total normal impulse
+    over the frame and the least separation seen; per ball touched (``balls``, world rows) the
+    farthest it got from where it started and the largest move in one substep, and the box around
+    the positions it passed."""
+
+    balls: np.ndarray
+    impulse: np.ndarray
+    least_separation: np.ndarray
+    farthest: np.ndarray
+    largest_move: np.ndarray
+    lo: np.ndarray  # (3, M) the lowest coordinates each ball had at a substep's end
+    hi: np.ndarray
+
+
+def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, threshold: float, warm,
+          substeps: int) -> Frame:  # fmt: skip
+    """Advance the balls the contacts ``c`` touch by ``dt`` in ``substeps`` substeps (their
+    states change in place; planes and other balls do not move here). ``warm`` (resting.WarmStart) gives
+    and keeps the impulses; ``threshold`` is the restitution threshold (m/s)."""
+    h = dt / substeps
+    n_balls = model.spheres.count
+    rows = contact_rows(model, state, c)
+    k = _Rows(rows)
+    body = state.body
+    balls = k.balls
+    m_dyn = int(np.searchsorted(balls, n_balls))  # the static row N, if there, is the last column
+    idx = balls[:m_dyn]
+    live = slice(0, m_dyn)
+    m = k.m
+    x = np.zeros((3, m))
+    x[:, live] = body[idx, X].T
+    x0 = x.copy()
+    vw = np.zeros((6, m))
+    vw[:3, live] = body[idx, V].T
+    vw[3:, live] = body[idx, W].T
+    q = body[idx, Q].copy()
+    terms = compact_terms(forces, idx, n_balls)
+    constant = constant_acceleration(terms)
+
+    kc = k.k
+    n = k.n
+    ends_a, ends_b = k.ends[:kc], k.ends[kc:]
+    on_plane = rows.b == n_balls
+    # the surface's own speed along the normal (moving planes), to move their side of s
+    surface_n = _dot(k.surface, n) if k.moving else None
+    hertz = min(CONTACT_HERTZ, 0.25 / h)
+    ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
+    bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
+    mass_scale = np.where(on_plane, plane_soft.mass_scale, ball_soft.mass_scale)
+    impulse_scale = np.where(on_plane, plane_soft.impulse_scale, ball_soft.impulse_scale)
+    vn_start = _normal_speed(k, vw)  # recorded at the frame's start, for the restitution pass
+
+    keys = c.keys()
+    imp = warm.impulses(keys, c.normal, h)
+    apart = warm.apart_of(keys)
+    normal = imp.normal.copy()
+    tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
+    push = np.zeros((6, 2 * kc))
+    motion = np.empty((2, 3, kc))
+    total = np.zeros(kc)
+    least = c.gap.copy()
+    farthest, largest = np.zeros(m), np.zeros(m)
+    lo, hi = x[:, live].copy(), x[:, live].copy()
+
+    for i in range(substeps):
+        # 1. integrate velocities
+        lin, ang = _accelerations(terms, constant, x[:, live], vw[:, live], q)
+        vw[:3, live] += lin * h
+        vw[3:, live] += ang * h
+        # 2. warm start
+        _apply(k, vw, push, normal, tangential)
+        # 3. solve with the soft bias
+        s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, i * h)
+        # the contacts that can push this substep: pressed already, or closing faster than their gap
+        k.share_among((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
+        speculative = s > 0.0
+        target = np.where(speculative, -s / h, np.minimum(-bias_rate * (s - apart), MAX_PUSH))
+        scale = np.where(speculative, 1.0, mass_scale)
+        keep = np.where(speculative, 0.0, impulse_scale)
+        normal, tangential = _sweeps(
+            k, vw, push, normal, tangential, target, scale, keep, motion, SOLVE_SWEEPS
+        )
+        # 4. integrate positions (and orientations)
+        before = x[:, live].copy()
+        x[:, live] += vw[:3, live] * h
+        _turn(q, vw[3:, live], h)
+        # 5. relax: no bias, so the push-out leaves no velocity behind
+        s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, (i + 1) * h)
+        np.minimum(least, s, out=least)
+        target = np.where(s > 0.0, -s / h, 0.0)
+        normal, tangential = _sweeps(k, vw, push, normal, tangential, target, 1.0, 0.0, motion, RELAX_SWEEPS)
+        total += normal
+        # what the checks need: how far each ball got, and where
+        moved = x[:, live] - before
+        np.maximum(largest[live], _length(moved), out=largest[live])
+        np.maximum(farthest[live], _length(x[:, live] - x0[:, live]), out=farthest[live])
+        np.minimum(lo, x[:, live], out=lo)
+        np.maximum(hi, x[:, live], out=hi)
+
+    warm.keep(keys, Impulses(normal, tangential[0].T.copy(), tangential[1].T.copy()), h)
+    total += restitution_pass(rows, k, vw, normal, vn_start, threshold, total > 0.0)
+    body[idx, X] = x[:, live].T
+    body[idx, V] = vw[:3, live].T
+    body[idx, W] = vw[3:, live].T
+    body[idx, Q] = q
+    # what the substeps left overlapping is moved apart by positions alone (penetration.py)
+    # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
+    # heap of balls created at one point is pushed apart, never launched by a jump of positions)
+    s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
+    slop = SLOP * np.where(
+        on_plane,
+        model.spheres.radius[c.a],
+        np.minimum(*(model.spheres.radius[e] for e in (c.a, np.minimum(c.b, n_balls - 1)))),
+    )
+    made = s - np.minimum(c.gap + MAX_PUSH * dt, -slop)
+    if (made < -penetration.OVERLAP_TOLERANCE).any():
+        # those deeper than the slop go back to 0.8 of it, so they are not caught again next frame
+        made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -0.8 * slop), made)
+        pos = with_static(body[:, X])
+        jacobi.separate(c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, SEPARATE_SWEEPS)
+        new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
+        _pay_for_lift(model, state, body[:, X], new)
+        moved = new - body[:, X]
+        ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
+        d = ma - mb
+        np.minimum(least, s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
+                   out=least)  # fmt: skip
+        body[:, X] = new
+    _out_of_planes(model, state, c, rows, least, x0, idx, dt)
+    # what the springs hold apart for the next frame: the moving apart by positions, up to the overlap
+    # each contact's load needs, s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))
+    x[:, live] = body[idx, X].T
+    s_end = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
+    s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
+    held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
+    warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
+    return Frame(balls, total, least, farthest, largest, lo, hi)
+
+
+def _pay_for_lift(model, state, old: np.ndarray, new: np.ndarray) -> None:
+    """``penetration.pay_for_lift`` (the potential energy moved positions add, ΔU = −Σ m·g·Δx, taken
+    out of the moved balls' kinetic energy) with its sums in a fixed order, elementwise and then
+    ``np.cumsum``, instead of matrix products whose bits depend on the BLAS kernel."""
+    moved = np.flatnonzero((new != old).any(axis=1))
+    if moved.size == 0:
+        return
+    mass, g = model.spheres.mass[moved], model.gravity
+    d = new[moved] - old[moved]
+    lift = -float(np.cumsum(mass * (d[:, 0] * g[0] + d[:, 1] * g[1] + d[:, 2] * g[2]))[-1])
+    if lift <= 0.0:
+        return
+    v = state.body[moved, V]
+    kinetic = 0.5 * float(np.cumsum(mass * (v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]))[-1])
+    scale = math.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
+    state.body[moved, V] = v * scale
+
+
+def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.ndarray, x0: np.ndarray,
+                   idx: np.ndarray, dt: float) -> None:  # fmt: skip
+    """Planes win: a ball the frame left deeper in a plane than it started is moved back out along the
+    plane's normal (positions only, paying for the lift as penetration.py does). Shared among all of a
+    ball's contacts, the masses split many ways, the solve cannot always hold a crowd off a floor."""
+    on = np.flatnonzero(rows.b == model.spheres.count)
+    if on.size == 0:
+        return
+    body = state.body
+    start = np.zeros((len(body), 3))
+    start[idx] = x0[:, : len(idx)].T
+    a, nrm = c.a[on], c.normal[on]
+    d = body[a, 0:3] - start[a]
+    s = c.gap[on] + d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2]
+    if rows.moving:  # the plane's surface moves on over the frame too
+        u = rows.surface[on]
+        s -= (u[:, 0] * nrm[:, 0] + u[:, 1] * nrm[:, 1] + u[:, 2] * nrm[:, 2]) * dt
+    deficit = np.maximum(np.minimum(c.gap[on], -SLOP * model.spheres.radius[a]) - s, 0.0)
+    if not (deficit > penetration.OVERLAP_TOLERANCE).any():
+        return
+    new = body[:, X].copy()
+    lift = np.zeros((len(body), 3))
+    np.add.at(lift, a, deficit[:, None] * nrm)
+    new += lift
+    _pay_for_lift(model, state, body[:, X], new)
+    body[:, X] = new
+    least[on] = np.minimum(least[on], s + deficit)
+
+
+def restitution_pass(rows: ContactRows, k: jacobi._Contacts, vw: np.ndarray, normal: np.ndarray,
+                     vn_start: np.ndarray, threshold: float, pressed: np.ndarray) -> np.ndarray:  # fmt: skip
+    """Box2D's restitution: each contact that closed faster than ``threshold`` when the frame began
+    (``vn_start``) and pushed during it (``pressed``) is driven to leave at e times that speed,
+    v_n ≥ −e·v_n₀, starting from the last substep's normal impulse ``normal`` (which the pass may take
+    back, never below zero). Normal impulses only, all bouncing contacts at once (Jacobi with mass
+    splitting over them). ``vw`` changes in place; returns the impulse added per contact.
+
+    This is the simultaneous-impact rule of the crowded step; another rule (impacts in waves) can
+    replace this function without touching the substeps."""
+    added = np.zeros(len(normal))
+    bouncing = np.flatnonzero(pressed & (vn_start < -threshold) & (rows.restitution > 0.0))
+    if bouncing.size == 0:
+        return added
+    sub = jacobi._Contacts(rows.subset(bouncing))
+    cols = np.searchsorted(k.balls, sub.balls)  # the bouncing balls among the frame's columns
+    v = vw[:3, cols]
+    target = -rows.restitution[bouncing] * vn_start[bouncing]
+    start = normal[bouncing]
+    acc = start.copy()
+    lin = np.empty((3, 2 * sub.k))
+    for _ in range(RESTITUTION_SWEEPS):
+        g = np.take(v, sub.ends, axis=1)
+        vn = _dot(g[:, : sub.k] - g[:, sub.k :], sub.n)
+        if sub.moving:
+            vn -= _dot(sub.surface, sub.n)
+        new = np.maximum(acc + sub.m_n * (target - vn), 0.0)
+        d_n = new - acc
+        acc = new
+        np.multiply(d_n, sub.n, out=lin[:, : sub.k])
+        np.negative(lin[:, : sub.k], out=lin[:, sub.k :])
+        v += sub.add_up(lin) * sub.inverse[:3]
+    vw[:3, cols] = v
+    added[bouncing] = acc - start
+    return added
+
+
+def compact_terms(forces: list[ForceTerm], idx: np.ndarray, n_balls: int) -> list[ForceTerm]:
+    """The force terms for the balls ``idx`` alone: per-ball constant terms (a sleeping ball's hold)
+    cut down to their rows."""
+    terms: list[ForceTerm] = []
+    for term in forces:
+        if isinstance(term, ConstantPerBall) and len(term.lin) == n_balls:
+            term = ConstantPerBall(term.lin[idx], term.ang[idx])
+        terms.append(term)
+    return terms
+
+
+def _accelerations(terms, constant, x: np.ndarray, vw: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Linear and angular accelerations (3, M) of the balls under the force terms, at this state."""
+    if constant is not None:
+        lin, ang = constant
+        return lin.T, ang.T
+    state = np.empty((x.shape[1], 13))
+    state[:, X], state[:, V], state[:, Q], state[:, W] = x.T, vw[:3].T, q, vw[3:].T
+    lin, ang = np.zeros((len(state), 3)), np.zeros((len(state), 3))
+    for term in terms:
+        term.add(state, lin, ang)
+    return lin.T, ang.T
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise dot products of (3, K) arrays, summed x, y, z in that order."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _length(a: np.ndarray) -> np.ndarray:
+    return np.sqrt(_dot(a, a))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise a × b of (3, K) arrays."""
+    return np.stack((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
+
+
+def _normal_speed(k: jacobi._Contacts, vw: np.ndarray) -> np.ndarray:
+    """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
+    against a moving plane's surface."""
+    g = np.take(vw[:3], k.ends, axis=1)
+    vn = _dot(g[:, : k.k] - g[:, k.k :], k.n)
+    if k.moving:
+        vn -= _dot(k.surface, k.n)
+    return vn
+
+
+def _separation(s0: np.ndarray, n: np.ndarray, x: np.ndarray, x0: np.ndarray, ends_a: np.ndarray,
+                ends_b: np.ndarray, surface_n: np.ndarray | None, t: float) -> np.ndarray:  # fmt: skip
+    """s = s₀ + n·(Δx_a − Δx_b): the separation from the balls' moved positions (and a moving plane's
+    surface, moved by its speed along n for ``t``)."""
+    d = x - x0
+    s = s0 + _dot(np.take(d, ends_a, axis=1) - np.take(d, ends_b, axis=1), n)
+    if surface_n is not None:
+        s -= surface_n * t
+    return s
+
+
+def _apply(k: jacobi._Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray,
+           tangential: np.ndarray) -> None:  # fmt: skip
+    """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both
+    balls of every contact: Δv = ±m⁻¹·P, Δω = −ρ·I⁻¹·(n × P_t) ± I⁻¹·R."""
+    kc = k.k
+    d_t, d_r = tangential[0], tangential[1]
+    linear = normal * k.n + d_t
+    turn = _cross(k.n, d_t)
+    push[:3, :kc] = linear
+    np.negative(linear, out=push[:3, kc:])
+    np.multiply(turn, k.minus_ra, out=push[3:, :kc])
+    push[3:, :kc] += d_r
+    np.multiply(turn, k.minus_rb, out=push[3:, kc:])
+    push[3:, kc:] -= d_r
+    total = k.add_up(push)
+    total *= k.inverse
+    vw += total
+
+
+def _sweeps(k: jacobi._Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
+            target: np.ndarray, scale, keep, motion: np.ndarray,
+            sweeps: int) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """``sweeps`` Jacobi sweeps of the soft normal update ΔP = m_n·scale·(target − v_n) − keep·P
+    (P ≥ 0); the last one also updates friction (the Coulomb cone |P_t| ≤ μ·P_n) and rolling
+    resistance (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses."""
+    kc, n = k.k, k.n
+    m_n = k.m_n * scale
+    # The spring's give, −keep·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
+    # keep·P/m_whole), so a ball's share of a crowd does not make its contacts softer.
+    keep = keep * k.m_n * k.whole
+    for sweep in range(sweeps):
+        if sweep < sweeps - 1:  # normal impulses alone: only the linear velocities matter
+            vn = _normal_speed(k, vw)
+            new = np.maximum(normal + m_n * (target - vn) - keep * normal, 0.0)
+            d_n = new - normal
+            normal = new
+            lin = push[:3]
+            np.multiply(d_n, n, out=lin[:, :kc])
+            np.negative(lin[:, :kc], out=lin[:, kc:])
+            vw[:3] += k.add_up(lin) * k.inverse[:3]
+            continue
+        g = np.take(vw, k.ends, axis=1)
+        va, wa, vb, wb = g[:3, :kc], g[3:, :kc], g[:3, kc:], g[3:, kc:]
+        # contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b)
+        arm_spin = g[3:] * k.arms
+        rel = va - vb + _cross(n, arm_spin[:, :kc] + arm_spin[:, kc:])
+        if k.moving:
+            rel -= k.surface
+        vn = _dot(rel, n)
+        new = np.maximum(normal + m_n * (target - vn) - keep * normal, 0.0)
+        d_n = new - normal
+        normal = new
+        # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
+        motion[0] = rel - vn * n
+        motion[1] = wa - wb
+        if k.moving:
+            motion[1] -= k.spin
+        candidate = tangential - k.m_tr * motion
+        length = np.sqrt(candidate[:, 0] * candidate[:, 0] + candidate[:, 1] * candidate[:, 1]
+                         + candidate[:, 2] * candidate[:, 2] + 1e-300)  # fmt: skip
+        new_tr = candidate * np.minimum(k.limits * normal / length, 1.0)[:, None, :]
+        d_tr = new_tr - tangential
+        tangential = new_tr
+        _apply(k, vw, push, d_n, d_tr)
+    return normal, tangential
+
+
+def _turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
+    """q ← normalise(q + h·½·(ω, 0)⊗q), in place (``w`` is (3, M))."""
+    dq = np.empty_like(q)
+    quaternion.derivative(q, w.T, dq)
+    q += h * dq
+    quaternion.normalize(q, out=q)
+
+
+def hold_energy(model, state, before: np.ndarray, balls: np.ndarray) -> None:
+    """Take any energy the frame gained out of the balls ``balls`` it moved: with no moving plane doing
+    work, a frame may lose energy (inelastic bounces, friction) but never gain it, yet pushing overlaps
+    apart lifts balls and a Jacobi restitution pass can overshoot. Their velocities relative to their
+    centre of mass (and their spins) are scaled by the one factor that gives back the energy they had
+    at ``before``, E = ½·m·v² + ½·I·ω² − m·g·x: momentum is kept, and so is every direction of motion."""
+    sleeping = state.sleep.asleep
+    if len(sleeping) == len(state.body) and sleeping.any():
+        balls = balls[~sleeping[balls]]
+    if balls.size == 0:
+        return
+    sph = model.spheres
+    mass, inertia = sph.mass[balls], 1.0 / sph.inv_inertia[balls]
+    g = model.gravity
+    old, new = before[balls], state.body[balls]
+
+    def energy(rows: np.ndarray) -> tuple[float, float]:
+        v, w, x = rows[:, V], rows[:, W], rows[:, X]
+        kinetic = 0.5 * (mass * _dot(v.T, v.T) + inertia * _dot(w.T, w.T))
+        potential = -mass * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
+        return float(np.cumsum(kinetic)[-1]), float(np.cumsum(potential)[-1])
+
+    k0, u0 = energy(old)
+    k1, u1 = energy(new)
+    if k1 + u1 <= k0 + u0:
+        return
+    total = float(np.cumsum(mass)[-1])
+    v, w = new[:, V], new[:, W]
+    momentum = mass[:, None] * v
+    v_cm = np.array([float(np.cumsum(momentum[:, i])[-1]) for i in range(3)]) / total
+    k_cm = 0.5 * total * float(v_cm[0] ** 2 + v_cm[1] ** 2 + v_cm[2] ** 2)
+    k_rel = k1 - k_cm
+    room = k0 + u0 - u1 - k_cm
+    scale = math.sqrt(room / k_rel) if room > 0.0 and k_rel > 0.0 else 0.0
+    state.body[balls, V] = v_cm + scale * (v - v_cm)
+    state.body[balls, W] = scale * w
