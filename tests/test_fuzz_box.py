@@ -162,6 +162,23 @@ COINCIDENT_TWENTY = Box(
     restitution=0.0,
 )  # fmt: skip
 
+# 17 balls (8 mm to 16 cm), 15 of them at the centre of an 81 cm box, one 8 mm ball among them thrown
+# sideways at 52 m/s: in the first step, taken whole (crowded), the 8 mm ball leaves through a wall.
+CROWDED_SEVENTEEN = Box(
+    half=0.40261038753223904, wall_restitution=0.0, wall_friction=0.0, slope_rotation=_Z,
+    slope_size=0.12891706606196074, slope_spin=_Z, gravity=(0.0, -9.81, 0.0), integrator="rk2", dt=1 / 60,
+    positions=(*[_Z] * 9, (0.0, 0.0, 0.27919199995142824), *[_Z] * 4, (0.0, 0.3243346498637686, 0.0), _Z, _Z),
+    velocities=(*[_Z] * 8, (52.0, 0.0, 0.0), (0.0, 0.0, -14.384744437198236), *[_Z] * 4, (0.0, -15.0, 0.0),
+                _Z, _Z),
+    radii=(0.15572612795457624, 0.1331577862085064, 0.10467323710196619, 0.09382568303811017,
+           0.031468315032122496, 0.05243490285369637, 0.05053417718474767, 0.0211505995011891,
+           0.00833333333332249, 0.1209658730494455, 0.06270845715369124, 0.03395084722614494,
+           0.034255406076298865, 0.022907074746832054, 0.07827573766847043, 0.032599652411756,
+           0.048029467743620706),
+    masses=(1.0,) * 17,
+    restitution=0.0,
+)  # fmt: skip
+
 # Three balls apart at the start, thrown at up to 52 m/s under sideways gravity of 23 m/s²: saved
 # after 17 steps, two of them touch with 0.57 mm of overlap, and the saved file is refused for it.
 SAVED_TOUCHING = Box(
@@ -182,6 +199,7 @@ SAVED_TOUCHING = Box(
 
 
 @FUZZ
+@example(CROWDED_SEVENTEEN)
 @example(COINCIDENT_TWENTY)
 @given(boxes())
 def test_no_ball_ever_leaves_a_closed_box(box):

@@ -67,6 +67,26 @@ def test_ten_balls_at_1000_m_per_s_in_a_closed_box_never_leave_it(seed):
         assert (np.abs(world.spheres.positions) <= 0.5 - r + 1e-6).all()
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_fifty_balls_at_3_m_per_s_stepped_a_tenth_of_a_second_at_a_time_never_leave_a_closed_box(seed):
+    # 3 m/s for 0.1 s is 6 radii a step: every step is crowded (crowd_limit 4) and its frames must be
+    # retried with more substeps or split, never taken as one long substep through a wall.
+    rng = np.random.default_rng(seed)
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.crowd_limit = 4
+    closed_box(world, 0.5)
+    r = 0.05
+    grid = np.stack(np.meshgrid(*[np.arange(-0.375, 0.4, 0.125)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    positions = grid[rng.choice(len(grid), 50, replace=False)]  # 0.125 m apart: none overlap
+    velocity = rng.normal(0, 1, (50, 3))
+    world.add_spheres(
+        positions, radius=r, velocity=3.0 * velocity / np.linalg.norm(velocity, axis=1)[:, None]
+    )
+    for _ in range(30):
+        world.step(0.1)
+        assert (np.abs(world.spheres.positions) <= 0.5 - r + 1e-6).all()
+
+
 def test_a_hot_gas_at_250_m_per_s_stays_in_its_closed_box():
     world = read_scene("scenes/gas.toml").world
     scale = 250.0 / np.linalg.norm(world.spheres.velocities, axis=1).mean()
