@@ -10,19 +10,12 @@ constant velocity is the bounce on a still one, seen from the plane (Galilean in
 from __future__ import annotations
 
 import math
-from dataclasses import replace
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import exact, quaternion
-from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
 from .state import Columns, State
-
-if TYPE_CHECKING:  # rows.py imports this module
-    from .impulses import Impulses
-    from .rows import ContactRows
 
 
 def set_orientation(pose: Columns, i: int, q: np.ndarray) -> None:
@@ -144,60 +137,6 @@ def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.
     linear = np.linalg.norm(dv, axis=1) + np.linalg.norm(acc, axis=1) * h
     far = np.linalg.norm(state.body[ball, 0:3] - state.planes.center[plane], axis=1) + linear * h
     return linear + np.linalg.norm(pl.angular_velocity[plane], axis=1) * far
-
-
-def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray, h: float,
-                warm: Impulses) -> ContactRows:  # fmt: skip
-    """The contact rows of ``c`` as they will be ``h`` seconds on, on turning planes (``rows`` as they
-    are now, ``lin`` the balls' free accelerations, ``warm`` the warm-start impulses, whose friction is
-    turned onto the new tangent planes in place).
-
-    The resting solve makes the velocities at the end of its interval satisfy the contacts, so it must
-    ask it of the contacts as they are then: on a plane turning at ω the normal will have turned by ω·h,
-    and the surface under the ball moves at v_p + ω × (p₁ − c₁) where the ball will be (its path under
-    its free acceleration and its own contact's warm-start force). Asked of today's normal and today's
-    surface velocity instead, a ball rolling at s along the plane ends the interval approaching or
-    leaving it at about 2·ω·s·h (the Coriolis term of the plane's turning frame), and drifts into it or
-    off it by about ω·s·h² a step: a see-saw's rolling balls sank a few µm and then floated just beyond
-    the contact slop, where every step split at their little falls.
-
-    The normal turns by Rodrigues' formula with each plane's cos(ω·h) and sin(ω·h) taken once per plane
-    from ``exact.sin_cos`` (a few planes, not balls).
-    """
-    pl = model.planes
-    on_plane = c.kind == SPHERE_PLANE
-    turning = pl.angular_velocity.any(axis=1)
-    on = np.flatnonzero(on_plane & turning[np.where(on_plane, c.other, 0)])
-    if on.size == 0:
-        return rows
-    plane, ball = c.other[on], c.a[on]
-    spin = pl.angular_velocity[plane]
-    rates = [math.sqrt(x * x + y * y + z * z) for x, y, z in pl.angular_velocity.tolist()]
-    sin_all, cos_all = exact.sin_cos(np.array(rates) * h)  # not math's: its bits depend on the CPU
-    sin, cos = sin_all[plane, None], cos_all[plane, None]
-    axis = spin / np.array(rates)[plane, None]
-    n = rows.normal[on]
-    # Rodrigues: n·cos θ + (k × n)·sin θ + k·(k·n)·(1 − cos θ)
-    turned = n * cos + cross(axis, n) * sin + axis * (_dot(axis, n) * (1.0 - cos))
-    push = (warm.normal[on, None] * n + warm.friction[on]) * (rows.inv_mass_a[on] / h)[:, None]
-    body, radius = state.body, model.spheres.radius[ball, None]
-    centre = model.integrator.path_end(body[ball, 0:3], body[ball, 3:6], lin[ball] + push, h)
-    plane_centre = state.planes.center[plane] + pl.velocity[plane] * h
-    normal, arm_a, surface = rows.normal.copy(), rows.arm_a.copy(), rows.surface.copy()
-    normal[on] = turned
-    arm_a[on] = -radius * turned
-    surface[on] = pl.velocity[plane] + cross(spin, centre - radius * turned - plane_centre)
-    friction = warm.friction[on]
-    warm.friction[on] = friction - _dot(friction, turned) * turned
-    end = replace(rows, normal=normal, arm_a=arm_a, surface=surface)
-    if "colours" in rows.__dict__:  # the same contacts: the same colours
-        end.__dict__["colours"] = rows.colours
-    return end
-
-
-def _dot(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Row-wise p·q as a (K, 1) column, summed in a fixed order."""
-    return p[:, 0:1] * q[:, 0:1] + p[:, 1:2] * q[:, 1:2] + p[:, 2:3] * q[:, 2:3]
 
 
 def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:

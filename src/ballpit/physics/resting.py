@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import moving_planes, solver
+from . import solver
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
-from .rows import ContactRows
+from .rows import ContactRows, rows_at_end
 from .settings import JACOBI_FROM, WARM_START_SPAN
 from .solver import Impulses
 from .state import State, V, W, with_static
@@ -95,7 +95,7 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
     if rows.moving and model.planes.angular_velocity.any():  # the contacts at the interval's end
-        rows = moving_planes.rows_at_end(model, state, c, rows, lin, h, imp)
+        rows = rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
     if h >= WARM_START_SPAN * dt:

@@ -51,7 +51,6 @@ class HudFacts:
 
     @classmethod
     def of(cls, sim: Simulation) -> HudFacts:
-        from .hud import profile_body, timeline_lines
         from .simulation import Phase
 
         world = sim.world
@@ -159,3 +158,31 @@ def capture(sim: Simulation, needs: Needs = Needs(), hud: HudFacts | None = None
         shown.energy = copy.deepcopy(timeline.energy)
     shown.hud = hud if hud is not None else (HudFacts.of(sim) if needs.hud else None)
     return shown
+
+
+def profile_body(sim: Simulation) -> list[str]:
+    """The profile page's lines after its title: where the step's time went over the last second,
+    stage by stage (``World.profile``, like Box2D's b2Profile), with intervals, pairs and contacts per
+    step; empty before any step."""
+    p = sim.profile
+    if not p.steps:
+        return []
+    return [f"{p.steps} steps", f"{'stage':<15}{'per step':>12}", *p.lines()]
+
+
+def timeline_lines(sim: Simulation) -> list[str]:
+    """HUD lines for the history or replay and, with ghosts on, each integrator's energy drift."""
+    from .ghosts import LABELS
+
+    timeline = sim.timeline
+    lines = []
+    span = timeline.span()
+    if timeline.replay is not None:
+        lines.append(f"replay      {timeline.replay.trajectory.path.name}")
+    elif span is not None and timeline.history is not None and timeline.history.in_past:
+        lines.append(f"history     {span[2] - span[1]:.3f} s in the past; Space resumes")
+    for name, drift, main in timeline.drifts():
+        what = "run  " if main else "ghost"
+        unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"
+        lines.append(f"E drift {what} {LABELS[name]:5s} {drift:+10.4f} {unit}")
+    return lines
