@@ -27,6 +27,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # subprocesses under other CPU kernels: `make test`, not `make check`
+
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 # Simulated seconds per scene: past the first differing step found before the fix, and short.
 SECONDS = {"pile": 1.75, "seesaw": 1.0, "slopes": 2.0, "incline": 2.0, "cradle": 2.0, "billiards": 1.0}
@@ -48,6 +50,7 @@ import hashlib, sys
 from pathlib import Path
 import numpy as np
 from ballpit.scene import read_scene
+
 for arg in sys.argv[1:]:
     path, seconds = arg.rsplit("=", 1)
     scene = read_scene(Path(path))

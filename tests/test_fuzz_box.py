@@ -24,12 +24,15 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 import tomlkit
 from hypothesis import HealthCheck, Phase, example, given, settings
 from hypothesis import strategies as st
 
 import ballpit
 from ballpit.scene import read_scene
+
+pytestmark = pytest.mark.slow  # a hypothesis search over whole runs: `make test`, not `make check`
 
 EXAMPLES = int(os.environ.get("BALLPIT_FUZZ_EXAMPLES", "6"))
 FIXED = os.environ.get("BALLPIT_FUZZ_RANDOM") != "1"

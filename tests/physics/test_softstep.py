@@ -67,6 +67,7 @@ def test_ten_balls_at_1000_m_per_s_in_a_closed_box_never_leave_it(seed):
         assert (np.abs(world.spheres.positions) <= 0.5 - r + 1e-6).all()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(3))
 def test_fifty_balls_at_3_m_per_s_stepped_a_tenth_of_a_second_at_a_time_never_leave_a_closed_box(seed):
     # 3 m/s for 0.1 s is 6 radii a step: every step is crowded (crowd_limit 4) and its frames must be
@@ -87,6 +88,7 @@ def test_fifty_balls_at_3_m_per_s_stepped_a_tenth_of_a_second_at_a_time_never_le
         assert (np.abs(world.spheres.positions) <= 0.5 - r + 1e-6).all()
 
 
+@pytest.mark.slow
 def test_a_hot_gas_at_250_m_per_s_stays_in_its_closed_box():
     world = read_scene("scenes/gas.toml").world
     scale = 250.0 / np.linalg.norm(world.spheres.velocities, axis=1).mean()
@@ -99,6 +101,7 @@ def test_a_hot_gas_at_250_m_per_s_stays_in_its_closed_box():
         assert (np.abs(world.spheres.positions) <= half - r + 1e-6).all()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("floor", ["level", "slope", "moving"])
 def test_sixty_coincident_balls_above_an_open_floor_never_go_through_it_nor_sink_in(floor):
     # All 60 created at one point 1 m up: they are pushed apart (at most MAX_PUSH) and land in a heap;
@@ -119,6 +122,7 @@ def test_sixty_coincident_balls_above_an_open_floor_never_go_through_it_nor_sink
         assert height.min() >= 0.95 * r
 
 
+@pytest.mark.slow
 def test_a_settled_pile_rests_below_a_millimetre_per_second_without_creeping():
     # 100 balls four deep, dropped into a small box and left for 3 s (no sleeping): over the next
     # second no ball moves faster than 1 mm/s, and none ends more than 1 mm from where it was.
@@ -143,6 +147,7 @@ def test_a_settled_pile_rests_below_a_millimetre_per_second_without_creeping():
     assert np.abs(world.spheres.positions - start).max() < 1e-3
 
 
+@pytest.mark.slow
 def test_columns_eight_balls_tall_stand_still_without_sinking_into_each_other():
     # 288 balls stacked in 36 straight columns, eight deep, wall to wall: the bottom contacts carry
     # seven balls' weight. A soft contact rests at the overlap its load needs, F·(1/m_a + 1/m_b)/ω²
