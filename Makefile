@@ -1,5 +1,5 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
-# `make check` is the inner loop: lint, format and the tests marked neither slow nor window (< 1 min).
+# `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min).
 # demo installs only what ballpit itself needs; test adds the test tools (pytest, ruff, scipy, ...).
 PYTHON ?= python3
 VENV := .venv
@@ -23,7 +23,7 @@ demo: $(VENV)/.ballpit
 check: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -q -m "not slow and not window"
+	$(PY) -m pytest -q -n auto -m "not slow and not window"
 
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

@@ -50,7 +50,6 @@ import hashlib, sys
 from pathlib import Path
 import numpy as np
 from ballpit.scene import read_scene
-
 for arg in sys.argv[1:]:
     path, seconds = arg.rsplit("=", 1)
     scene = read_scene(Path(path))
