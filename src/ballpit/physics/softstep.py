@@ -224,7 +224,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         pos = with_static(body[:, X])
         jacobi.separate(c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, SEPARATE_SWEEPS)
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
-        _pay_for_lift(model, state, body[:, X], new)
+        penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
         ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
         d = ma - mb
@@ -240,24 +240,6 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
     return Frame(balls, total, least, farthest, largest, lo, hi)
-
-
-def _pay_for_lift(model, state, old: np.ndarray, new: np.ndarray) -> None:
-    """``penetration.pay_for_lift`` (the potential energy moved positions add, ΔU = −Σ m·g·Δx, taken
-    out of the moved balls' kinetic energy) with its sums in a fixed order, elementwise and then
-    ``np.cumsum``, instead of matrix products whose bits depend on the BLAS kernel."""
-    moved = np.flatnonzero((new != old).any(axis=1))
-    if moved.size == 0:
-        return
-    mass, g = model.spheres.mass[moved], model.gravity
-    d = new[moved] - old[moved]
-    lift = -float(np.cumsum(mass * (d[:, 0] * g[0] + d[:, 1] * g[1] + d[:, 2] * g[2]))[-1])
-    if lift <= 0.0:
-        return
-    v = state.body[moved, V]
-    kinetic = 0.5 * float(np.cumsum(mass * (v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]))[-1])
-    scale = math.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
-    state.body[moved, V] = v * scale
 
 
 def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.ndarray, x0: np.ndarray,
@@ -284,7 +266,7 @@ def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.
     lift = np.zeros((len(body), 3))
     np.add.at(lift, a, deficit[:, None] * nrm)
     new += lift
-    _pay_for_lift(model, state, body[:, X], new)
+    penetration.pay_for_lift(model, state, body[:, X], new)
     body[:, X] = new
     least[on] = np.minimum(least[on], s + deficit)
 
