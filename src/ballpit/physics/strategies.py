@@ -78,33 +78,32 @@ class Step:
         self.intervals += 1
 
 
-def crowded_contacts(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray | None:
-    """Which of the contacts ``c`` a crowded step solves (a mask), or None when few enough pairs meet
-    to split the step.
+def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
+    """Whether the step is crowded: taken as one soft-step frame over every kept pair ``c`` instead of
+    split at each impact.
 
     Meetings are counted along today's normals: the gap after dt, g + v_n·dt + ½·a_n·dt², falls to
-    contact. More than ``model.crowd_limit`` meetings make the step crowded. Its contacts are every
-    pair within SPECULATIVE_REACH times the distance it could close (by the same bound the time of
-    impact uses), touching ones included.
+    contact. More than ``model.crowd_limit`` meetings make the step crowded; so does, among
+    CROWD_PAIRS kept pairs or more (a pile), any meeting or touching contact, and so does any overlap
+    deeper than CROWD_OVERLAP of a radius (``model.crowd_limit`` inf: never).
     """
     dt, model = step.dt, step.model
     if len(c) == 0:  # nothing near anything (free flight): nothing can meet
-        return None
+        return False
     many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
     # balls overlapping deeply (created at one point, or left so by a crowd) are pushed apart by the
     # soft step, whose planes hold, not jumped apart by positions
     deep = model.crowd_limit != np.inf and (c.gap < -CROWD_OVERLAP * model.spheres.radius[c.a]).any()
-    if not many and len(c) <= model.crowd_limit and not deep:  # too few pairs to be more meetings
-        return None
+    if deep:
+        return True
+    if not many and len(c) <= model.crowd_limit:  # too few pairs to be more meetings
+        return False
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
     # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
     # soft step it landed in, not alternately in the two
-    if meetings <= (0 if many else model.crowd_limit) and not (many and (c.gap < CONTACT_SLOP).any()):
-        if not deep:
-            return None
-    return speculative_reach(step, c, accel, dv, da)
+    return meetings > (0 if many else model.crowd_limit) or (many and bool((c.gap < CONTACT_SLOP).any()))
 
 
 def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray, dv: np.ndarray | None = None,
@@ -202,10 +201,14 @@ def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPer
     step.integrate(hold, remaining)
 
 
-def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: np.ndarray,
-                 accel: tuple[np.ndarray, np.ndarray]) -> bool:  # fmt: skip
-    """A crowded step as one frame of ``model.substeps`` soft substeps (softstep.py) over the contacts
-    of ``contacts`` where ``solved`` holds; True when it was taken so.
+def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarray]) -> bool:
+    """A crowded step as one frame of ``model.substeps`` soft substeps (softstep.py) over every kept
+    pair ``c``; True when it was taken so.
+
+    Every kept pair is solved, not just those closing now: within a frame a ball's neighbours change
+    speed (the ball under it stops on the floor, the one beside it bounces back), so a pair moving
+    together at the frame's start may meet at 5 m/s before its end. The kept pairs are every pair
+    whose paths' boxes meet; a speculative one pushes only if it closes faster than its gap allows.
 
     The soft step keeps the walls only while every ball it moves travels less than SUBSTEP_TRAVEL of
     its radius per substep, and while nothing it did not foresee happens. A frame is tried with twice
@@ -215,15 +218,13 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
     - a ball moved farther than that in a substep, or left the box its pairs were found from (then a
       pair the broad phase never saw could have met);
     - a solved contact overlapped deeper than DEEP_OVERLAP of the smaller radius at any substep's end;
-    - a pair left out of the contacts that could have met overlaps that deep at the end.
+    - a pair the kept pairs did not hold (a ball left its box) overlaps that deep at the end.
 
     When no try holds, the step is split at impacts instead (``split_at_impacts``, which passes
     through nothing, however fast).
     """
     model, state, dt, now = step.model, step.state, step.dt, step.state.time
     free, _ = accel
-    solved = solved | (contacts.kind == SPHERE_PLANE)  # every kept pair with a plane: planes hold
-    c = contacts.subset(solved)
     radius = np.append(model.spheres.radius, np.inf)
     v = with_static(state.body[:, V])
     acc = with_static(free)
@@ -236,7 +237,7 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
             step.doubt = "a ball could travel farther than SUBSTEP_TRAVEL radii in a substep"
             continue
         last = substeps == model.substeps << RETRIES
-        frame = _soft_frame(step, contacts, solved, c, accel, substeps, last)
+        frame = _soft_frame(step, c, substeps, last)
         if frame is not None:
             break
     else:
@@ -246,9 +247,7 @@ def crowded_step(step: Step, contacts: ContactPoints, pairs: KeptPairs, solved: 
     return True
 
 
-def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
-                accel: tuple[np.ndarray, np.ndarray], substeps: int,
-                last: bool) -> softstep.Frame | None:  # fmt: skip
+def _soft_frame(step: Step, c: ContactPoints, substeps: int, last: bool) -> softstep.Frame | None:
     """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone,
     the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted. The ``last`` try is
     kept when its only fault is a solved contact that overlapped deeper: that is no pass through
@@ -275,7 +274,7 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
             state.body[others] = rows
     moving_planes.advance(model, state, dt)
     with step.profile.stage("time of impact"):
-        step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before, substeps)
+        step.doubt = frame_doubt(step, c, frame, body_before)
     if step.doubt is None or (last and step.doubt == DEEPER):
         return frame
     state.body[:] = body_before  # undo it all
@@ -285,8 +284,7 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     return None
 
 
-def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
-                frame: softstep.Frame, before: np.ndarray, substeps: int) -> str | None:  # fmt: skip
+def frame_doubt(step: Step, c: ContactPoints, frame: softstep.Frame, before: np.ndarray) -> str | None:
     """Why a soft frame cannot be trusted (see ``crowded_step``), or None when it kept its promises.
 
     A ball that left the box its pairs were found from may have met a body the broad phase never
@@ -303,11 +301,6 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
     if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
         return DEEPER
-    # how far each ball got from where it started (the others flew straight)
-    far = np.zeros(n + 1)
-    moved = state.body[:, X] - before[:, X]
-    far[:n] = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2 + moved[:, 2] ** 2)
-    far[balls] = np.maximum(far[balls], frame.farthest[cols])
     kept = step.pairs.kept
     lo, hi = frame.lo, frame.hi
     centre = kept.centre[balls].T
@@ -317,18 +310,14 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         or (hi + r > kept.hi[balls].T).any()
         or (np.sqrt(corner[0] ** 2 + corner[1] ** 2 + corner[2] ** 2) + r > kept.reach[balls]).any()
     )
-    if escaped:  # pairs around where the balls are now; those not solved are the ones left out
-        free, _ = free_acceleration(state.body, step.forces)
-        pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free)
-        now = narrowphase.contact_points(model, state, pairs)
-        out = now.subset(~np.isin(now.keys(), c.keys()))
-        out.gap = _gap_from(out, before, model, state)
-    else:
-        out = contacts.subset(~solved)
-        near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
-        out = out.subset(near)
-        start = np.minimum(out.gap, 0.0)
-        out.gap = _gap_from(out, before, model, state) - start
+    if not escaped:  # every pair that could have met was solved
+        return None
+    # pairs around where the balls are now; those not solved are the ones left out
+    free, _ = free_acceleration(state.body, step.forces)
+    pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free)
+    now = narrowphase.contact_points(model, state, pairs)
+    out = now.subset(~np.isin(now.keys(), c.keys()))
+    out.gap = _gap_from(out, before, model, state)
     if len(out) == 0:
         return None
     on_plane = out.kind == SPHERE_PLANE

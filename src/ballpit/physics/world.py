@@ -336,8 +336,8 @@ class World:
                 with prof.stage("sleep"):
                     reach = strategies.speculative_reach(step, contacts, unheld)
         with prof.stage("crowd test"):
-            crowd = strategies.crowded_contacts(step, contacts, free)
-        if crowd is not None and strategies.crowded_step(step, contacts, pairs, crowd, (free, ang)):
+            crowd = strategies.crowded(step, contacts, free)
+        if crowd and strategies.crowded_step(step, contacts, (free, ang)):
             self.crowded_steps += 1
         else:
             strategies.split_at_impacts(step, contacts, pairs, (free, ang))
@@ -352,7 +352,7 @@ class World:
         state.time += dt
         record = step.events.record()
         prof.intervals, prof.pairs, prof.contacts = step.intervals, len(pairs), len(record)
-        prof.crowded = crowd is not None
+        prof.crowded = crowd
         prof.total = perf_counter() - began
         self.profile = prof
         return record
