@@ -1,82 +1,200 @@
-"""The real window's frame rate, as the title shows it: a 1280x720 viewer on an X display (Xvfb here),
-before X and while the drop runs, each run in a process of its own, runs of the scenes taken in turn.
+"""The real window's frame rate, as the title shows it, and the physics' real-time factor beside it: a
+viewer on an X display (Xvfb here) run by pyglet's own loop as ``ballpit view`` runs it, each run in a
+process of its own, runs of the scenes taken in turn.
 
-    DISPLAY=:1 .venv/bin/python benchmarks/viewer_window_fps.py --runs 3 slopes pile pile10k seesaw
+    DISPLAY=:1 .venv/bin/python benchmarks/viewer_window_fps.py --runs 5 --size 800x450 pile
+    DISPLAY=:1 .venv/bin/python benchmarks/viewer_window_fps.py --runs 3 --escape slopes pile pile10k
 
-Prints, per scene, the median frames per second over the runs before X and after it (from one second
-after X, for ``--seconds``), the physics' steps per second then, and the real-time factor the HUD
-showed. With ``--escape`` it also times Esc, Esc in the middle of a step: from the second key event to
-the window closed.
+Per scene, medians over the runs of:
+
+- ``fps_before_x``: the title's frame rate while the scene waits for X (``--seconds`` long);
+- the landing, from X until the simulated clock reaches ``--land`` seconds (pile.toml lands in its
+  first 2 s): ``land_fps`` frames per wall second, ``land_rtf`` simulated over wall seconds (1.00 is
+  real time; the clock cannot run ahead of real time), ``hud_rtf`` and ``hud_rtf_min`` the median and
+  lowest real-time factor the HUD showed meanwhile (read every 0.25 s from 0.75 s after X);
+- ``fps_after_x``, ``steps_per_second`` and ``real_time_factor`` (the HUD's) over ``--seconds`` from
+  one second after the landing;
+- with ``--threads``, the CPU each kind of thread used while the pile landed, in cores: the physics
+  thread, the window's (main) thread, llvmpipe's rasteriser threads and the rest;
+- with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end.
+
+``--env NAME=VALUE`` sets a variable for the child before anything loads (LP_NUM_THREADS, ...); the
+load average of the machine at the start is printed, since the two cores may be shared.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
 import time
 
 CHILD = r"""
-import json, re, sys, time
+import json, os, re, statistics, sys, time
+import pyglet
 from pyglet.window import key
 from ballpit.scene import default_scene_path
-from ballpit.viewer.app import Viewer
+from ballpit.viewer.app import FRAME_INTERVAL, Viewer
 
 name, seconds, quality, escape = sys.argv[1], float(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
+width, height, land = int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
 path = default_scene_path().with_name(name + ".toml")
-try:
-    viewer = Viewer(size=(1280, 720), scene_path=path, quality=quality)
-except TypeError:  # a viewer without the quality option
-    viewer = Viewer(size=(1280, 720), scene_path=path)
+viewer = Viewer(size=(width, height), scene_path=path, quality=quality)
 sim = viewer.sim
+TICK = os.sysconf("SC_CLK_TCK")
 
-def run_for(s):
-    end = time.perf_counter() + s
-    while time.perf_counter() < end:
-        viewer.pump()
 
-def rate(s):
-    frames, steps, t = viewer.frames, sim.steps_total, time.perf_counter()
-    run_for(s)
-    wall = time.perf_counter() - t
-    return (viewer.frames - frames) / wall, (sim.steps_total - steps) / wall
+def thread_cpu():
+    # CPU seconds of each thread of this process, by kind
+    thread = getattr(viewer.physics, "_thread", None)
+    physics = thread.native_id if thread is not None else None
+    out = {"physics": 0.0, "main": 0.0, "llvmpipe": 0.0, "other": 0.0}
+    for tid in os.listdir("/proc/self/task"):
+        try:
+            with open(f"/proc/self/task/{tid}/stat") as f:
+                stat = f.read()
+        except OSError:
+            continue
+        comm = stat[stat.index("(") + 1 : stat.rindex(")")]
+        fields = stat[stat.rindex(")") + 2 :].split()
+        cpu = (int(fields[11]) + int(fields[12])) / TICK
+        if int(tid) == physics:
+            out["physics"] += cpu
+        elif int(tid) == os.getpid():
+            out["main"] += cpu
+        elif comm.startswith("llvmpipe"):
+            out["llvmpipe"] += cpu
+        else:
+            out["other"] += cpu
+    child = getattr(getattr(viewer, "physics", None), "child_cpu", None)  # a physics process, if any
+    if child is not None:
+        out["physics"] += child()
+    try:  # the physics thread's time waiting for a core (the rest of its wall time not on one: asleep)
+        with open(f"/proc/self/task/{physics}/schedstat") as f:
+            out["physics_queued"] = int(f.read().split()[1]) / 1e9
+    except (OSError, TypeError):
+        out["physics_queued"] = 0.0
+    return out
 
-run_for(1.0)
+
+def hud_factor():
+    found = re.search(r"real-time factor (\d+\.\d+)", viewer.hud.text)
+    return float(found.group(1)) if found else None
+
+
 out = {}
-out["fps_before_x"], _ = rate(seconds)
-viewer.window.dispatch_event("on_key_press", key.X, 0)
-run_for(1.0)
-out["fps_after_x"], out["steps_per_second"] = rate(seconds)
-factor = re.search(r"real-time factor (\d+\.\d+)", viewer.hud.text)
-out["real_time_factor"] = float(factor.group(1)) if factor else None
+state = {"phase": "warm", "at": time.perf_counter() + 1.0}
+
+
+def mark():
+    return viewer.frames, sim_steps(), time.perf_counter()
+
+
+def sim_steps():
+    return getattr(viewer.physics, "steps_total", None) or sim.steps_total
+
+
+def sim_time():
+    clock = getattr(viewer.physics, "sim_time", None)
+    return clock() if clock is not None else sim.world.time
+
+
+def tick(_dt):
+    now = time.perf_counter()
+    phase = state["phase"]
+    if phase == "warm" and now >= state["at"]:
+        state.update(phase="before", at=now + seconds, mark=mark())
+    elif phase == "before" and now >= state["at"]:
+        frames, _, t = state["mark"]
+        out["fps_before_x"] = (viewer.frames - frames) / (now - t)
+        viewer.window.dispatch_event("on_key_press", key.X, 0)
+        idle = getattr(viewer.physics, "idle_seconds", 0.0)
+        captured = getattr(viewer.physics, "capture_seconds", 0.0)
+        state.update(phase="landing", mark=mark(), cpu=thread_cpu(), samples=[], sample_at=now + 0.75,
+                     idle=idle, captured=captured)
+    elif phase == "landing":
+        frames, _, t = state["mark"]
+        if now >= state["sample_at"]:
+            state["sample_at"] = now + 0.25
+            state["samples"].append(hud_factor())
+        simulated = sim_time()
+        if simulated >= land or now - t > 6 * land + 5:
+            wall = now - t
+            out["land_fps"] = (viewer.frames - frames) / wall
+            out["land_rtf"] = simulated / wall
+            samples = [s for s in state["samples"] if s is not None]
+            out["hud_rtf"] = statistics.median(samples) if samples else None
+            out["hud_rtf_min"] = min(samples) if samples else None
+            cpu = thread_cpu()
+            for kind, used in cpu.items():
+                out[f"cpu_{kind}"] = (used - state["cpu"][kind]) / wall
+            out["physics_cpu_per_sim_s"] = out["cpu_physics"] * wall / max(simulated, 1e-9)
+            out["physics_asleep"] = 1.0 - out["cpu_physics"] - out["cpu_physics_queued"]
+            out["physics_idle"] = (getattr(viewer.physics, "idle_seconds", 0.0) - state["idle"]) / wall
+            captured = getattr(viewer.physics, "capture_seconds", 0.0) - state["captured"]
+            out["physics_capture"] = captured / wall
+            state.update(phase="settle", at=now + 1.0)
+    elif phase == "settle" and now >= state["at"]:
+        state.update(phase="after", at=now + seconds, mark=mark())
+    elif phase == "after" and now >= state["at"]:
+        frames, steps, t = state["mark"]
+        out["fps_after_x"] = (viewer.frames - frames) / (now - t)
+        out["steps_per_second"] = (sim_steps() - steps) / (now - t)
+        out["real_time_factor"] = hud_factor()
+        if escape:
+            viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+            state.update(phase="escape", at=now + 10)
+        else:
+            pyglet.clock.unschedule(tick)
+            viewer.close()
+    elif phase == "escape":
+        busy = getattr(viewer.physics, "busy", None)
+        if (busy() if busy is not None else viewer.physics.lock.locked()) or now >= state["at"]:
+            pyglet.clock.unschedule(tick)  # a step is in progress: the worst moment to quit
+            state["pressed"] = time.perf_counter()
+            viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+
+
+pyglet.clock.schedule_interval(tick, 0.01)
+viewer.run()
 if escape:
-    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
-    viewer.pump()
-    lock = getattr(getattr(viewer, "physics", None), "lock", None)
-    if lock is not None:  # wait for a step in progress: the worst moment to quit
-        end = time.perf_counter() + 10
-        while not lock.locked() and time.perf_counter() < end:
-            viewer.pump()
-    pressed = time.perf_counter()
-    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
-    while not viewer.closed:
-        viewer.pump()
-    viewer.pump()
-    out["escape_seconds"] = time.perf_counter() - pressed
-else:
-    viewer.close()
-    viewer.pump()
+    out["escape_seconds"] = time.perf_counter() - state["pressed"]
 print("RESULT " + json.dumps(out), flush=True)
+os._exit(0)  # the physics may be mid-step (a daemon): do not wait for it
 """
 
+HEADLESS = r"""
+import json, sys, time
+from ballpit.scene import default_scene_path, read_scene
 
-def one_run(scene: str, seconds: float, quality: str, escape: bool) -> dict:
-    proc = subprocess.run(
-        [sys.executable, "-c", CHILD, scene, str(seconds), quality, "1" if escape else "0"],
-        capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
+name, land = sys.argv[1], float(sys.argv[2])
+scene = read_scene(default_scene_path().with_name(name + ".toml"))
+world, dt = scene.world, scene.timestep
+wall, cpu = time.perf_counter(), time.process_time()
+for _ in range(round(land / dt)):
+    world.step(dt)
+wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+print("RESULT " + json.dumps({"land_rtf": world.time / wall, "physics_cpu_per_sim_s": cpu / world.time}))
+"""
+
+COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fps_after_x",
+           "steps_per_second", "real_time_factor"]  # fmt: skip
+THREAD_COLUMNS = ["cpu_physics", "cpu_main", "cpu_llvmpipe", "cpu_other", "physics_cpu_per_sim_s",
+                  "cpu_physics_queued", "physics_asleep", "physics_idle", "physics_capture"]  # fmt: skip
+
+
+def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: dict[str, str],
+            headless: bool = False) -> dict:  # fmt: skip
+    """One viewer process on ``scene`` (or, ``headless``, its landing stepped with no window); returns
+    its measurements."""
+    command = [sys.executable, "-c", CHILD, scene, str(args.seconds), args.quality,
+               "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land)]  # fmt: skip
+    if headless:
+        command = [sys.executable, "-c", HEADLESS, scene, str(args.land)]
+    proc = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
     lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")]
     if not lines:
         raise RuntimeError(f"{scene}: no result\n{proc.stderr[-2000:]}")
@@ -88,17 +206,31 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenes", nargs="*", default=["slopes", "pile", "pile10k", "seesaw"])
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--seconds", type=float, default=4.0)
+    parser.add_argument("--land", type=float, default=2.0, help="simulated seconds the landing lasts")
+    parser.add_argument("--size", default="1280x720", help="window size, WIDTHxHEIGHT")
     parser.add_argument("--quality", default="auto", help="auto, low or high (the viewer's option)")
     parser.add_argument("--escape", action="store_true", help="also time Esc, Esc in the middle of a step")
+    parser.add_argument("--threads", action="store_true", help="CPU per kind of thread while it lands")
+    parser.add_argument("--env", action="append", default=[], help="NAME=VALUE for the viewer process")
+    parser.add_argument("--json", action="store_true", help="also print every run's numbers")
+    parser.add_argument("--headless", action="store_true", help="also step each landing with no window")
     args = parser.parse_args(argv)
+    size = tuple(int(v) for v in args.size.lower().split("x"))
+    env = dict(os.environ)
+    env.update(item.split("=", 1) for item in args.env)
+    load = open("/proc/loadavg").read().split()[0] if os.path.exists("/proc/loadavg") else "?"
     results: dict[str, list[dict]] = {s: [] for s in args.scenes}
+    if args.headless:
+        results.update({f"{s} (headless)": [] for s in args.scenes})
     for _ in range(args.runs):
         for scene in args.scenes:
-            results[scene].append(one_run(scene, args.seconds, args.quality, args.escape))
-    print(f"{time.strftime('%Y-%m-%d %H:%M')}, medians of {args.runs} runs, quality {args.quality}")
-    cols = ["fps_before_x", "fps_after_x", "steps_per_second", "real_time_factor"]
-    if args.escape:
-        cols.append("escape_seconds")
+            results[scene].append(one_run(scene, args, size, env))
+            if args.headless:
+                results[f"{scene} (headless)"].append(one_run(scene, args, size, env, headless=True))
+    extra = f", {' '.join(args.env)}" if args.env else ""
+    print(f"{time.strftime('%Y-%m-%d %H:%M')}, {size[0]}x{size[1]}, medians of {args.runs} runs, "
+          f"quality {args.quality}{extra}, load average {load} at the start")  # fmt: skip
+    cols = COLUMNS + (THREAD_COLUMNS if args.threads else []) + (["escape_seconds"] if args.escape else [])
     print("| scene | " + " | ".join(cols) + " |\n|---|" + "---|" * len(cols))
     for scene, runs in results.items():
         cells = []
@@ -106,6 +238,11 @@ def main(argv: list[str] | None = None) -> int:
             values = [r[c] for r in runs if r.get(c) is not None]
             cells.append(f"{statistics.median(values):.2f}" if values else "-")
         print(f"| {scene} | " + " | ".join(cells) + " |", flush=True)
+        if args.json:
+            for r in runs:
+                print(
+                    "  " + json.dumps({k: round(v, 3) if isinstance(v, float) else v for k, v in r.items()})
+                )
     return 0
 
 

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 
+from ballpit.scene import Scene, default_appearance
 from ballpit.viewer.handover import Needs, capture
 from ballpit.viewer.simulation import Phase, Simulation
 from ballpit.viewer.stepper import PhysicsThread
@@ -83,6 +84,26 @@ def test_the_real_time_factor_is_what_slow_steps_manage_not_the_time_scale():
     assert factor == np.float64(steps_per_second * sim.timestep) or math.isclose(
         factor, steps_per_second * sim.timestep, rel_tol=1e-9
     )
+
+
+def test_steps_slower_than_real_time_follow_each_other_without_a_pause():
+    """Frames of 1/60 s that each take 25 ms of wall time: the physics is behind, so it must step again at
+    once. Timing the next step from the batch's start slept about a third of every batch away (each
+    batch's own time only counted at the next), and the real-time factor fell below what steps manage."""
+    world = line_of_balls(3)
+    sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))
+    sim.before_step.append(lambda: time.sleep(0.025))
+    physics = PhysicsThread(sim)
+    try:
+        physics.submit(lambda s: s.start())
+        physics.run_free()
+        assert wait_for(lambda: sim.steps_total > 2)
+        idle, started = physics.idle_seconds, time.perf_counter()
+        time.sleep(1.0)
+        idle, wall = physics.idle_seconds - idle, time.perf_counter() - started
+    finally:
+        physics.stop()
+    assert idle < 0.05 * wall, (idle, wall)
 
 
 def test_stop_returns_at_once_in_the_middle_of_a_long_step():

@@ -71,6 +71,8 @@ class PhysicsThread:
         self._hud_at = 0.0
         self.crash: str | None = None  # an error that stopped the thread (shown in the HUD)
         self.captures = 0
+        self.idle_seconds = 0.0  # wall s slept by choice while free (paused, or ahead of the clock)
+        self.capture_seconds = 0.0  # wall s spent capturing hand-overs (benchmarks read both)
         with self.lock:
             self._shown = self._capture(force_hud=True)
         self._previous_switch = sys.getswitchinterval()
@@ -166,11 +168,15 @@ class PhysicsThread:
                     print(f"ballpit: {self.crash}", file=sys.stderr, flush=True)
                     return
                 sim = self.sim
-                if sim.phase is Phase.RUNNING:  # sleep until the next step is due
-                    wait = max(sim.timestep - sim.accumulator, 0.0) / max(sim.time_scale, 1e-9)
+                if sim.phase is Phase.RUNNING:  # sleep until the next step is due, counting the
+                    # time this batch took as passed: a batch slower than real time owes a step now
+                    owed = max(sim.timestep - sim.accumulator, 0.0) / max(sim.time_scale, 1e-9)
+                    wait = owed - (time.perf_counter() - last)
             if wait > 0.0:
+                slept = time.perf_counter()
                 self._wake.wait(min(wait, IDLE_WAIT))
                 self._wake.clear()
+                self.idle_seconds += time.perf_counter() - slept
 
     def _apply_commands(self) -> int:
         """Run the commands sent so far; returns how many."""
@@ -199,6 +205,8 @@ class PhysicsThread:
         return capture(self.sim, needs, hud=hud)
 
     def _publish(self, force_hud: bool) -> None:
+        started = time.perf_counter()
         shown = self._capture(force_hud)
+        self.capture_seconds += time.perf_counter() - started
         with self._handover_lock:
             self._shown = shown
