@@ -37,7 +37,7 @@ import json, os, re, statistics, sys, time
 import pyglet
 from pyglet.window import key
 from ballpit.scene import default_scene_path
-from ballpit.viewer.app import FRAME_INTERVAL, Viewer
+from ballpit.viewer.app import Viewer
 
 name, seconds, quality, escape = sys.argv[1], float(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
 width, height, land = int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])

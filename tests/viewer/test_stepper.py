@@ -101,9 +101,27 @@ def test_steps_slower_than_real_time_follow_each_other_without_a_pause():
         idle, started = physics.idle_seconds, time.perf_counter()
         time.sleep(1.0)
         idle, wall = physics.idle_seconds - idle, time.perf_counter() - started
+        busy = physics.busy_fraction
     finally:
         physics.stop()
     assert idle < 0.05 * wall, (idle, wall)
+    assert busy > 0.9  # what the window reads to draw less (pacing.py)
+
+
+def test_the_busy_share_is_near_zero_while_nothing_steps_and_near_one_while_steps_run_late():
+    world = line_of_balls(3)
+    sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))
+    physics = PhysicsThread(sim)
+    try:
+        physics.run_free()
+        time.sleep(1.2)  # waiting for X: it only sleeps
+        waiting = physics.busy_fraction
+        sim.before_step.append(lambda: time.sleep(0.03))  # every 1/60 s step takes 30 ms
+        physics.submit(lambda s: s.start())
+        assert wait_for(lambda: physics.busy_fraction > 0.9, timeout=5.0)
+    finally:
+        physics.stop()
+    assert waiting < 0.1
 
 
 def test_stop_returns_at_once_in_the_middle_of_a_long_step():

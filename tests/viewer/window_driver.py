@@ -454,10 +454,14 @@ def _drop_and_land(viewer: Viewer, seconds: float) -> dict:
     pump_until(viewer, lambda: viewer.sim.steps_total > 0, timeout=30)
     pump_for(viewer, 1.0)  # into the landing: the balls reach the floor
     frames, steps, started = viewer.frames, viewer.sim.steps_total, time.perf_counter()
-    pump_for(viewer, seconds)
-    wall = time.perf_counter() - started
+    pump_for(viewer, seconds - 1.0)
+    sim_time, last_second = viewer.sim.world.time, time.perf_counter()
+    pump_for(viewer, 1.0)
+    now = time.perf_counter()
+    wall = now - started
     steps_per_second = (viewer.sim.steps_total - steps) / wall
     return {"fps": (viewer.frames - frames) / wall, "steps_per_second": steps_per_second,
+            "last_second_factor": (viewer.sim.world.time - sim_time) / (now - last_second),
             "caption": viewer.window.caption, "hud": viewer.hud.text}  # fmt: skip
 
 
@@ -503,6 +507,66 @@ def escape_mid_step(workdir: Path) -> dict:
     return out
 
 
+def pacing(workdir: Path) -> dict:
+    """pyglet's own loop (``Viewer.run``, as ``ballpit view``) on balls whose every step takes 30 ms of
+    wall time, far behind real time, then paused: the redraw interval the window schedules and the
+    frames it draws in a second each way."""
+    import pyglet
+    from pyglet.window import key
+
+    viewer = Viewer(size=(320, 180), world=balls_world())
+    OPENED.append(viewer)
+    viewer.sim.before_step.append(lambda: time.sleep(0.03))
+    out: dict = {}
+    marks: dict = {}
+    started = time.perf_counter()
+
+    def tap(symbol: int) -> None:
+        viewer.window.dispatch_event("on_key_press", symbol, 0)
+        viewer.window.dispatch_event("on_key_release", symbol, 0)
+
+    def seen(name: str) -> None:
+        frames, at = marks.pop(name)
+        out[name] = {"interval": viewer._interval, "busy": viewer.physics.busy_fraction,
+                     "fps": (viewer.frames - frames) / (time.perf_counter() - at)}  # fmt: skip
+
+    def script(_dt: float) -> None:
+        t = time.perf_counter() - started
+        if t > 0.4 and "waiting" not in out:
+            out["waiting"] = {"interval": viewer._interval}
+            tap(key.X)
+        elif t > 2.5 and "running" not in out and "running" not in marks:
+            marks["running"] = (viewer.frames, time.perf_counter())
+        elif t > 3.5 and "running" in marks:
+            seen("running")
+            tap(key.SPACE)
+        elif t > 5.0 and "paused" not in out and "paused" not in marks:
+            marks["paused"] = (viewer.frames, time.perf_counter())
+        elif t > 6.0 and "paused" in marks:
+            seen("paused")
+            pyglet.clock.unschedule(script)
+            viewer.close()
+        elif t > 30:
+            viewer.close()
+
+    pyglet.clock.schedule_interval(script, 0.02)
+    viewer.run()
+    return out
+
+
+def rasteriser_threads(workdir: Path) -> dict:
+    """A drawn frame, then the threads of this process: how many are llvmpipe's rasterisers."""
+    viewer = open_viewer(world=balls_world())
+    pump(viewer, 3)
+    names = []
+    for tid in os.listdir("/proc/self/task"):
+        with open(f"/proc/self/task/{tid}/comm") as f:
+            names.append(f.read().strip())
+    return {"renderer": viewer.renderer_name, "cores": len(os.sched_getaffinity(0)),
+            "rasterisers": sum(name.startswith("llvmpipe") for name in names),
+            "variable": os.environ.get("LP_NUM_THREADS")}  # fmt: skip
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
@@ -520,6 +584,8 @@ SCENARIOS = {
         pile_landing,
         escape_mid_step,
         view_reuse,
+        pacing,
+        rasteriser_threads,
     )
 }
 

@@ -21,12 +21,12 @@ from pathlib import Path
 from . import backend, controls
 from .controls import Action
 from .handover import Needs, Shown
+from .pacing import FramePacer
 from .simulation import Simulation
 
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
-FRAME_INTERVAL = 1.0 / 120.0  # redraw rate asked of pyglet's loop (vsync may cap it lower)
 SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
 
 
@@ -97,6 +97,9 @@ class Viewer:
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
         self.physics = PhysicsThread(self.sim, needs=self._needs)
+        self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
+        self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
+        self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
         self.screen = ScreenOverlay(self.window, self.physics)
         self._interaction_seconds: deque[float] = deque()
         self._interaction_input: tuple = ()
@@ -478,7 +481,8 @@ class Viewer:
         if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + HUD_INTERVAL
             if self.hud.page == "profile":
-                drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)"]
+                drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)",
+                         f"drawing     {self.pacer.describe()}"]  # fmt: skip
                 self.hud.set_text(profile_lines(shown.hud, drawn))
             else:
                 extra, shot = self.interaction.hud_lines(), self.interaction.shot_speed
@@ -546,8 +550,27 @@ class Viewer:
         self.window.flip()
 
     def run(self) -> None:
-        """pyglet's event loop until the window closes."""
-        self._pyglet.app.run(FRAME_INTERVAL)
+        """pyglet's event loop until the window closes, drawing at the pacer's rate (pacing.py)."""
+        self._due = None
+        self._pyglet.clock.schedule_once(self._redraw, 0.0)
+        self._pyglet.app.run(None)  # None: the window schedules its own redraws
+
+    def _redraw(self, dt: float) -> None:
+        """One frame of pyglet's loop (draw and flip, ``Window.draw``), then the next one scheduled at
+        the pacer's interval after this one was due, not after it came: a frame the loop ran late (the
+        machine busy) is followed by an earlier one, so the rate drawn is the rate asked. pyglet's own
+        ``schedule_interval`` counts from each late call, so every delay lowers the rate."""
+        if self.closed or self._window_closed:
+            return
+        self.window.draw(dt)
+        clock = self._pyglet.clock.get_default()
+        now = clock.time()
+        self._interval = interval = self.pacer.interval(self.physics.busy_fraction)
+        due = (now if self._due is None else self._due) + interval
+        self._due = due if due > now else now  # more than a frame late: do not try to catch up more
+        # schedule_once counts from the loop's tick (clock.last_ts) unless that is 0.2 s old
+        base = now if clock.last_ts is None or now - clock.last_ts > 0.2 else clock.last_ts
+        clock.schedule_once(self._redraw, max(self._due - base, 0.0))
 
 
 def _gl_renderer() -> str:

@@ -33,7 +33,22 @@ def use_headless() -> None:
 
 def use_window() -> None:
     """Open real windows (X11/GLX on Linux). Call before importing any GL module."""
+    leave_a_core_to_the_physics()
     _select("window")
+
+
+def leave_a_core_to_the_physics() -> None:
+    """Ask Mesa's llvmpipe for one rasteriser thread fewer than the cores this process may use.
+
+    llvmpipe rasterises each frame on ``LP_NUM_THREADS`` threads, by default one per core, so on two
+    cores a frame briefly takes the core the physics thread steps on as well (three threads wanting two
+    cores). With one fewer, the window's thread waits for the rasteriser while it draws and the physics
+    keeps its core. Mesa reads the variable when the first GL context is made, so this runs before the
+    window opens; a value already set is kept, and a GPU's driver ignores it.
+    """
+    if "LP_NUM_THREADS" in os.environ or not hasattr(os, "sched_getaffinity"):
+        return
+    os.environ["LP_NUM_THREADS"] = str(max(len(os.sched_getaffinity(0)) - 1, 1))
 
 
 def _select(mode: str) -> None:

@@ -45,6 +45,7 @@ from .simulation import Phase, Simulation
 HUD_INTERVAL = 0.1  # seconds between readings of the HUD's facts (energy, drifts, profile)
 IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no command came
 IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
+BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = float(os.environ.get("BALLPIT_SWITCH", "0.001"))
@@ -71,7 +72,11 @@ class PhysicsThread:
         self._hud_at = 0.0
         self.crash: str | None = None  # an error that stopped the thread (shown in the HUD)
         self.captures = 0
-        self.idle_seconds = 0.0  # wall s slept by choice while free (paused, or ahead of the clock)
+        self.idle_seconds = 0.0  # wall s slept by choice (paused, waiting for X, ahead of the clock)
+        # the share of the latest BUSY_WINDOW the thread spent stepping or waiting for a core or the
+        # GIL, not sleeping by choice: near 1, it is behind real time (the window draws less, pacing.py)
+        self.busy_fraction = 0.0
+        self._busy_since, self._busy_idle = time.perf_counter(), 0.0
         self.capture_seconds = 0.0  # wall s spent capturing hand-overs (benchmarks read both)
         with self.lock:
             self._shown = self._capture(force_hud=True)
@@ -143,9 +148,9 @@ class PhysicsThread:
     def _run(self) -> None:
         last = published = time.perf_counter()
         while not self._stopped:
+            self._measure_busy()
             if not self._free:
-                self._wake.wait(IDLE_WAIT)
-                self._wake.clear()
+                self._sleep(IDLE_WAIT)
                 continue
             wait = IDLE_WAIT
             with self.lock:
@@ -173,10 +178,23 @@ class PhysicsThread:
                     owed = max(sim.timestep - sim.accumulator, 0.0) / max(sim.time_scale, 1e-9)
                     wait = owed - (time.perf_counter() - last)
             if wait > 0.0:
-                slept = time.perf_counter()
-                self._wake.wait(min(wait, IDLE_WAIT))
-                self._wake.clear()
-                self.idle_seconds += time.perf_counter() - slept
+                self._sleep(min(wait, IDLE_WAIT))
+
+    def _sleep(self, seconds: float) -> None:
+        """Wait until ``seconds`` pass or a command comes, counting the time as idle."""
+        slept = time.perf_counter()
+        self._wake.wait(seconds)
+        self._wake.clear()
+        self.idle_seconds += time.perf_counter() - slept
+
+    def _measure_busy(self) -> None:
+        """Every ``BUSY_WINDOW`` seconds, the share of them the thread did not sleep by choice."""
+        now = time.perf_counter()
+        elapsed = now - self._busy_since
+        if elapsed >= BUSY_WINDOW:
+            idle = self.idle_seconds - self._busy_idle
+            self.busy_fraction = min(max(1.0 - idle / elapsed, 0.0), 1.0)
+            self._busy_since, self._busy_idle = now, self.idle_seconds
 
     def _apply_commands(self) -> int:
         """Run the commands sent so far; returns how many."""

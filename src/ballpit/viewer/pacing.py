@@ -1,0 +1,45 @@
+"""How often the window draws: 60 frames a second, fewer while the physics needs the CPU they cost.
+
+On a machine with few cores and a CPU rasteriser (two cores and llvmpipe here) every frame is CPU the
+physics thread does not get: a frame of pile.toml at 800x450 costs about 9 ms of CPU between the
+window's thread and llvmpipe's, so 60 frames a second take about half a core. Drawing at 33 instead
+gave the physics beside it about a quarter more steps while the pile lands (benchmarks/
+viewer_window_fps.py, docs/benchmarks.md). So the window draws at ``FAST_FPS`` while the physics
+thread has time to spare, steps down to ``SLOW_FPS`` (above the 30 FPS the viewer promises) while it
+is busy nearly all the time, that is behind real time or about to be, and goes back up once it has
+slack again. The two thresholds are apart so the rate does not flip every time the busy share is
+measured. A GPU draws a frame in a fraction of a millisecond of CPU; there the physics rarely needs
+the slower rate, and when it does (a scene too heavy for real time) nothing is lost by it.
+
+No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+FAST_FPS = 60.0  # frames a second while the physics has time to spare (a usual display's rate)
+SLOW_FPS = 33.0  # while it needs the CPU: just above the 30 FPS floor, with room for late frames
+BUSY_SLOW = 0.9  # the physics spent at least this share of its last measured stretch stepping: slow
+BUSY_FAST = 0.7  # at most this share: the full rate again
+
+
+@dataclass
+class FramePacer:
+    """Chooses the time between frames from the physics thread's busy share (0 to 1)."""
+
+    slow: bool = False
+
+    def interval(self, busy: float) -> float:
+        """Seconds between frames, given the share of the latest stretch the physics spent stepping."""
+        if busy >= BUSY_SLOW:
+            self.slow = True
+        elif busy <= BUSY_FAST:
+            self.slow = False
+        return 1.0 / (SLOW_FPS if self.slow else FAST_FPS)
+
+    def describe(self) -> str:
+        """For the profile page: the rate chosen and why."""
+        if self.slow:
+            return f"{SLOW_FPS:g} FPS at most: the physics needs the CPU"
+        return f"{FAST_FPS:g} FPS at most"
