@@ -304,7 +304,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--sizes", type=_sizes, help="comma-separated ball counts (default per workload)")
     parser.add_argument(
-        "--steps", type=count, default=None, help="steps to time (default: 1 s of simulation)"
+        "--steps",
+        type=count,
+        default=None,
+        help="steps of 1/240 s to time (default: 1 s of simulation; ballpit's pile and settled round up "
+        "to whole 1/60 s frames)",
     )
     parser.add_argument("--pybullet", action="store_true", help="also run PyBullet on the same workload")
     parser.add_argument(
