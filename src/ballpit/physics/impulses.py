@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import exact
+
 
 @dataclass
 class Impulses:
@@ -22,7 +24,7 @@ class Impulses:
 
 def cap(vectors: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """Scale each row down to length ≤ limit (the friction cone and the rolling-resistance limit)."""
-    length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors) + 1e-300)  # + tiny: no 0/0 at zero
+    length = np.sqrt(exact.dot(vectors, vectors) + 1e-300)  # + tiny: no 0/0 at zero
     return vectors * np.minimum(limit / length, 1.0)[:, None]
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import solver
+from . import exact, solver
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
@@ -44,7 +44,7 @@ class WarmStart:
         friction = self.forces.friction[src] * h
         n = normal[found]
         imp.friction[found] = (
-            friction - np.einsum("ij,ij->i", friction, n)[:, None] * n
+            friction - exact.dot(friction, n)[:, None] * n
         )  # onto today's tangent plane
         imp.rolling[found] = self.forces.rolling[src] * h
         return imp

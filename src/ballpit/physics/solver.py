@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jacobi
+from . import exact, jacobi
 from .impulses import Impulses, cap, skew
 from .rows import ContactRows
 from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
@@ -131,7 +131,7 @@ def solve(
             rel = va - vb + np.einsum("kij,kj->ki", c.nx, c.ra * wa + c.rb * wb)
             if c.moving:  # relative to a moving plane's surface
                 rel -= c.surface
-            vn = np.einsum("ij,ij->i", rel, c.n)
+            vn = exact.dot(rel, c.n)
 
             # normal: the accumulated impulse stays ≥ 0
             old = normal[k]
