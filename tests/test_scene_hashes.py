@@ -65,6 +65,9 @@ solve, the lever arms, the warm start's projection, the overlap removal) began t
 first to last, as the Jacobi sweeps and the soft step already did; einsum over a row of three sums
 (x + z) + y. One order for every solve, so that the contact model can be written once (#22); cannon,
 both cradles, incline and seesaw are unchanged. The new hashes are the same under the old-CPU settings.
+pile and pile10k, when the Jacobi sweeps and the soft step began to form a contact's tangential
+effective mass as the colour-by-colour solve does, ((1/m_a + ρ_a²/I_a) + 1/m_b) + ρ_b²/I_b with each
+ball's split inverses, not as two sums added: one formula for every solve (#22).
 """
 
 from __future__ import annotations
@@ -88,8 +91,8 @@ HASHES = {
     "billiards": "e0d169b730e971780504227d8c909478f6ca490843cbc27c4ea9f19ebf49e69f",
     "incline": "2b0d33dc38bf229efc8cbcfd5c7862c6d75a650fd97eb0636de4ed0a47122f78",
     "gas": "5ac4faca78c1d93397524bd78cb2aac39f8d474920c36e8d601f99895a6d5c22",
-    "pile": "9fc57e20489aa80a5ec66e4d9536ee270792eb366b87021844f28341239da4da",
-    "pile10k": "735af12328634ab0682c7700e723d662c66ba9ac315753b4b09388983ce66fed",
+    "pile": "b8324937975d4c07e70e61a00768871fac8a61a05045eac26e8d6b1d87d04e99",
+    "pile10k": "381eb100c40a8bbcb34d581932f489f51be575e5c2bd89f4a3e77d5afc34cb95",
     "seesaw": "1db6077f7dc856c99a595f58c9ce44355c5ad3d48cc8b26f371637280149cb93",
     "integrators": "6b5660784fe07980213cac925f171cb63a8e7fb141e33353e1a41bd2e1aef24b",
 }

@@ -84,7 +84,7 @@ class _Contacts(_Ends):
         # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts):
         # normal, then tangential (friction) and angular (rolling resistance) stacked as (2, 1, K)
         self.m_n = 1.0 / (sa * ima + sb * imb)
-        m_t = 1.0 / (sa * (ima + ra**2 * iia) + sb * (imb + rb**2 * iib))
+        m_t = 1.0 / ((sa * ima + ra**2 * (sa * iia)) + sb * imb + rb**2 * (sb * iib))
         m_r = 1.0 / np.maximum(sa * iia + sb * iib, 1e-300)
         self.m_tr = np.stack((m_t, m_r))[:, None, :]
         # the friction cone μ·P_n and the rolling limit ρ·r·P_n, per unit of normal impulse

@@ -76,7 +76,9 @@ class _Rows(jacobi._Contacts):
         share = np.maximum(counts, 1.0)
         sa, sb = share[self.ends[:k]], share[self.ends[k:]]
         self.m_n = 1.0 / (sa * self.ima + sb * self.imb)
-        m_t = 1.0 / (sa * (self.ima + self.ra2 * self.iia) + sb * (self.imb + self.rb2 * self.iib))
+        m_t = 1.0 / (
+            (sa * self.ima + self.ra2 * (sa * self.iia)) + sb * self.imb + self.rb2 * (sb * self.iib)
+        )
         m_r = 1.0 / np.maximum(sa * self.iia + sb * self.iib, 1e-300)
         self.m_tr = np.stack((m_t, m_r))[:, None, :]
 
