@@ -38,6 +38,7 @@ import math
 import numpy as np
 
 from . import exact, solver
+from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
 from .rows import ContactRows
@@ -49,7 +50,6 @@ from .settings import (
     MAX_WAVES,
     WAVE_ITERATIONS,
 )
-from .solver import Impulses
 from .state import State, V, W, with_static
 
 

@@ -16,8 +16,8 @@ from functools import cached_property
 import numpy as np
 
 from . import exact, moving_planes
+from .contact_model import Impulses
 from .contacts import SPHERE_PLANE, ContactPoints, take_indices
-from .impulses import Impulses
 from .model import Model
 from .state import State
 
