@@ -94,6 +94,17 @@ def contact_velocity(v_a: np.ndarray, w_a: np.ndarray, v_b: np.ndarray, w_b: np.
     return rel
 
 
+def normal_speed(
+    v_a: np.ndarray, v_b: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None
+) -> np.ndarray:
+    """Each contact's normal speed v_n = (v_a − v_b)·n (negative: closing), against a moving plane's
+    ``surface``; spin never changes it on spheres (a lever arm is parallel to n)."""
+    v_n = dot(v_a - v_b, n)
+    if surface is not None:
+        v_n -= dot(surface, n)
+    return v_n
+
+
 def normal_impulse(accumulated: np.ndarray, m_n: np.ndarray, target: np.ndarray, v_n: np.ndarray,
                    give: np.ndarray | float | None = None) -> np.ndarray:  # fmt: skip
     """The new accumulated normal impulse that drives v_n towards ``target``, kept ≥ 0 (a contact
@@ -114,6 +125,14 @@ def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     np.sqrt(length, out=length)
     scale = np.minimum(limit / length, 1.0)
     return candidate * scale[..., None, :]
+
+
+def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How an overlap moving apart by positions is shared: a moves along n by its part of the overlap
+    and b by its (negative) part, each in proportion to its inverse mass (split, in jacobi.py), so the
+    lighter ball moves farther and a plane (inverse mass 0) not at all."""
+    total = inv_mass_a + inv_mass_b
+    return inv_mass_a / total, -inv_mass_b / total
 
 
 def turn(n: np.ndarray, tangential: np.ndarray) -> np.ndarray:

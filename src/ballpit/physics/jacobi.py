@@ -172,10 +172,7 @@ def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | N
     """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it on
     spheres), against a moving plane's ``surface``."""
     g = np.take(v[:3], c.ends, axis=1)
-    vn = model.dot(g[:, : c.k] - g[:, c.k :], n)
-    if surface is not None:
-        vn -= model.dot(surface, n)
-    return vn
+    return model.normal_speed(g[:, : c.k], g[:, c.k :], n, surface)
 
 
 def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray) -> None:
@@ -249,7 +246,7 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
     e = Ends(a, b, 3)  # rows x, y, z
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
     wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
-    fa, fb = wa / (wa + wb), -wb / (wa + wb)  # each end's part of the contact's correction
+    fa, fb = model.separation_parts(wa, wb)  # each end's part of the contact's correction
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
     start = model.dot(n, np.take(x, ends[:k], axis=1) - np.take(x, ends[k:], axis=1))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, jacobi
+from . import contact_model, exact, jacobi
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
@@ -41,14 +41,14 @@ def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) ->
     """Gauss–Seidel sweeps over the contact colours; ``pos`` (N+1, 3) changes in place."""
     n = c.normal
     offset = exact.dot(n, pos[c.a] - pos[c.b]) - c.gap
-    share = rows.inv_mass_a / (rows.inv_mass_a + rows.inv_mass_b)
+    part_a, part_b = contact_model.separation_parts(rows.inv_mass_a, rows.inv_mass_b)
     for _ in range(PENETRATION_SWEEPS):
         for idx in rows.colours:
             a, b = c.a[idx], c.b[idx]
             gap = exact.dot(n[idx], pos[a] - pos[b]) - offset[idx]
             depth = np.maximum(-gap, 0.0)[:, None] * n[idx]
-            pos[a] += depth * share[idx, None]
-            pos[b] -= depth * (1.0 - share[idx, None])
+            pos[a] += depth * part_a[idx, None]
+            pos[b] += depth * part_b[idx, None]
         pos[-1] = 0.0
 
 
