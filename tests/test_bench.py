@@ -31,11 +31,12 @@ def test_settled_layout_is_columns_of_touching_balls_on_the_floor():
 
 
 def test_bench_prints_a_row_per_workload_and_size(capsys):
+    # ballpit takes a pile in 1/60 s frames of four 1/240 s substeps: 3 steps round up to one frame
     assert bench.main(["--workload", "pile", "--sizes", "8,27", "--steps", "3"]) == 0
     out = capsys.readouterr().out
     assert out.count("steps/s") == 1, "one table, printed once"
     table = [line.split() for line in out.splitlines() if line.startswith("ballpit  ")]
-    assert [(r[1], int(r[2]), int(r[3])) for r in table] == [("pile", 8, 3), ("pile", 27, 3)]
+    assert [(r[1], int(r[2]), int(r[3])) for r in table] == [("pile", 8, 4), ("pile", 27, 4)]
     assert all(float(r[4]) > 0 and float(r[5]) > 0 for r in table)
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ballpit.physics import jacobi, solver
-from ballpit.physics.impulses import Impulses
+from ballpit.physics.contact_model import Impulses
 from ballpit.physics.rows import ContactRows
 from ballpit.physics.settings import JACOBI_FROM, JACOBI_SWEEPS
 

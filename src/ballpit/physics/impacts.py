@@ -37,7 +37,8 @@ import math
 
 import numpy as np
 
-from . import exact, solver
+from . import contact_model, solver
+from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
 from .rows import ContactRows
@@ -49,15 +50,14 @@ from .settings import (
     MAX_WAVES,
     WAVE_ITERATIONS,
 )
-from .solver import Impulses
 from .state import State, V, W, with_static
 
 
-def normal_speeds(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Each contact's normal speed v_n (negative: closing), from the (N+1, 3) velocities ``v`` and
-    spins ``w`` (row N the static world), relative to a moving plane's surface."""
-    rel, n = _relative_velocity(c, rows, v, w), c.normal
-    return rel[:, 0] * n[:, 0] + rel[:, 1] * n[:, 1] + rel[:, 2] * n[:, 2]
+def normal_speeds(rows: ContactRows, v: np.ndarray) -> np.ndarray:
+    """Each contact's normal speed v_n (negative: closing), from the (N+1, 3) velocities ``v`` (row N the
+    static world), relative to a moving plane's surface (``contact_model.normal_speed``)."""
+    v_a, v_b = np.take(v, rows.a, axis=0).T, np.take(v, rows.b, axis=0).T
+    return contact_model.normal_speed(v_a, v_b, rows.normal.T, rows.surface.T if rows.moving else None)
 
 
 def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, restitution_threshold: float,
@@ -78,7 +78,7 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, re
     waves = 0
     iterations = max(model.solver_iterations, WAVE_ITERATIONS)
     while waves < MAX_WAVES:
-        vn = normal_speeds(c, rows, v, w)
+        vn = normal_speeds(rows, v)
         arriving = (vn < min_normal_speed - APPROACH_SPEED) & (-vn > restitution_threshold)
         if not arriving.any():
             break
@@ -109,7 +109,7 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     if len(c) == 0:
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
-    vn = normal_speeds(c, rows, v, w)
+    vn = normal_speeds(rows, v)
     seeds = vn < min_normal_speed - APPROACH_SPEED
     if not seeds.any():
         return
@@ -124,15 +124,6 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     state.body[:, W] = w[:-1]
     hit = c.subset(near)
     events.add(now, hit, hit.keys(), imp.normal * scale)
-
-
-def _relative_velocity(c: ContactPoints, rows: ContactRows, v: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Each contact point's velocity of a relative to b (to a moving plane's surface), (K, 3)."""
-    va, vb, wa, wb = (np.take(u, ends, axis=0) for u in (v, w) for ends in (c.a, c.b))
-    rel = va + exact.cross(wa, rows.arm_a) - vb - exact.cross(wb, rows.arm_b)
-    if rows.moving:
-        rel -= rows.surface
-    return rel
 
 
 def _island(model: Model, c: ContactPoints, seeds: np.ndarray) -> np.ndarray:

@@ -3,7 +3,8 @@
 The colour-by-colour Gauss–Seidel solve (``solver.py``) costs a few dozen NumPy calls per colour per
 sweep; a pile has 12–17 colours, so at a thousand balls the calls' fixed cost is most of the step.
 Here every contact is updated at once from the same velocities, so a sweep is a fixed number of calls
-whatever the colours.
+whatever the colours. The split step's large solves and every solve of the soft step (softstep.py:
+its substeps' soft solve and relax, its restitution) are these sweeps.
 
 Plain Jacobi overshoots where several contacts push one ball. Mass splitting (Tonge, Benevolenski
 and Voroshilov, "Mass splitting for jitter-free parallel rigid body simulation", SIGGRAPH 2012) gives
@@ -16,20 +17,22 @@ A normal-only sweep needs only the balls' linear velocities: a sphere's lever ar
 contact normal, so spin never changes v_n. It costs about a fifth of a full sweep (normal, friction
 and rolling resistance), so a solve may update friction in only some of its sweeps.
 
-The contact model (normal, Coulomb friction, rolling resistance; targets, accumulated impulses and
-their clamps) is exactly the one in ``solver.py``; only the order of the updates differs.
+The contact model itself (effective masses, the normal impulse, the friction cone and rolling limit,
+what an impulse does to the balls) is contact_model.py's, as in ``solver.py``; only the order of the
+updates differs.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .impulses import Impulses, skew
+from . import contact_model as model
+from .contact_model import Impulses
 from .rows import ContactRows
 from .settings import CONVERGED, SORT_ENDS_FROM
 
 
-class _Ends:
+class Ends:
     """Both ends of K contacts as columns of a compact array of the M balls they touch: ``ends`` holds
     each contact's a then b, ``share`` each ball's number of contacts (its mass is split that many
     ways), and ``add_up`` adds per-end values back per ball with one ``np.bincount``."""
@@ -59,7 +62,7 @@ class _Ends:
         return summed.reshape(rows, self.m)
 
 
-class _Contacts(_Ends):
+class Contacts(Ends):
     """What the sweeps need of the contacts, gathered once per solve, with vectors as (3, K) rows.
 
     Velocities are the rows of one (6, M) array [v; ω] of just the M balls the contacts touch; ``ends``
@@ -72,34 +75,44 @@ class _Contacts(_Ends):
 
     def __init__(self, contacts: ContactRows) -> None:
         super().__init__(contacts.a, contacts.b, 6)  # rows v and ω
-        k, m, share = self.k, self.m, self.share
-        sa, sb = share[self.ends[:k]], share[self.ends[k:]]
-        ima, imb = contacts.inv_mass_a, contacts.inv_mass_b
-        iia, iib = contacts.inv_inertia_a, contacts.inv_inertia_b
-        ra, rb = contacts.arm_lengths()
-        self.minus_ra, self.minus_rb = -ra, -rb
-        self.arms = np.concatenate((ra, rb))  # each end's lever arm ρ, in the order of ``ends``
+        k, m = self.k, self.m
+        self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
+        self.iia, self.iib = contacts.inv_inertia_a, contacts.inv_inertia_b
+        self.ra, self.rb = contacts.arm_lengths()
+        self.minus_ra, self.minus_rb = -self.ra, -self.rb
         self.n = np.ascontiguousarray(contacts.normal.T)
-        self.nx = np.ascontiguousarray(skew(contacts.normal).transpose(1, 2, 0))  # (3, 3, K): [n]×
-        # effective masses of the split bodies (each ball's m⁻¹ and I⁻¹ times its number of contacts):
-        # normal, then tangential (friction) and angular (rolling resistance) stacked as (2, 1, K)
-        self.m_n = 1.0 / (sa * ima + sb * imb)
-        m_t = 1.0 / (sa * (ima + ra**2 * iia) + sb * (imb + rb**2 * iib))
-        m_r = 1.0 / np.maximum(sa * iia + sb * iib, 1e-300)
-        self.m_tr = np.stack((m_t, m_r))[:, None, :]
-        # the friction cone μ·P_n and the rolling limit ρ·r·P_n, per unit of normal impulse
+        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse
         self.limits = np.stack((contacts.friction, contacts.rolling))
         # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
-        inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = ima, imb
-        inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = iia, iib
+        inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
+        inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = self.iia, self.iib
         self.inverse = np.repeat(np.stack((inv_mass, inv_inertia)), 3, axis=0)  # (6, M)
-        # bounds on how much a unit of impulse changes a contact's velocity, for the convergence test
-        self.inv_m_n = float((ima + imb).max())
-        self.inv_m_t = float((ima + ra**2 * iia + imb + rb**2 * iib).max())
+        # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
+        # velocity, for the convergence test
+        inv_n, inv_t, _ = model.inverse_effective_masses(self.ima, self.imb, self.iia, self.iib, self.ra,
+                                                         self.rb)  # fmt: skip
+        self.whole = inv_n
+        self.inv_m_n, self.inv_m_t = float(inv_n.max()), float(inv_t.max())
         self.moving = contacts.moving
         self.surface = np.ascontiguousarray(contacts.surface.T)
         self.spin = np.ascontiguousarray(contacts.spin.T)
+        self.split()
+
+    def split(self, pushing: np.ndarray | None = None) -> None:
+        """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
+        each): the effective masses ``m_n`` and ``m_tr`` (friction, then rolling, as (2, 1, K))."""
+        k = self.k
+        if pushing is None:
+            share = self.share
+        else:
+            counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
+            share = np.maximum(counts, 1.0)
+        sa, sb = share[self.ends[:k]], share[self.ends[k:]]
+        m_n, m_t, m_r = model.effective_masses(sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib,
+                                               self.ra, self.rb)  # fmt: skip
+        self.m_n = m_n
+        self.m_tr = np.stack((m_t, m_r))[:, None, :]
 
 
 def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarray, imp: Impulses,
@@ -110,25 +123,16 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     Only every ``friction_every``-th sweep (and the last) updates friction and rolling resistance; the
     sweeps between update the normal impulses alone. A normal-only sweep needs just the balls' linear
     velocities (a sphere's lever arm is parallel to its normal, so spin does not move v_n), which makes
-    it about a fifth of the cost of a full one."""
+    it about a fifth of the cost of a full one. The sweeps stop early once a full one changes no
+    contact's velocity by more than CONVERGED."""
     if len(contacts) == 0:
         return imp
-    c = _Contacts(contacts)
-    k = c.k
+    c = Contacts(contacts)
     vw = np.ascontiguousarray(np.hstack((v[c.balls], w[c.balls])).T)  # (6, M)
-    push = np.zeros((6, 2 * k))  # what each contact adds to its a (columns :k) and its b (columns k:)
-    normal = imp.normal.copy()
     # accumulated friction (row 0) and rolling-resistance (row 1) impulses
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-    motion = np.empty((2, 3, k))  # slip at the contact point, and relative spin
-    for sweep in range(iterations):
-        full = (sweep + 1) % friction_every == 0 or sweep == iterations - 1
-        if full:
-            normal, tangential, change = _full_sweep(c, vw, push, normal, tangential, target, motion)
-        else:
-            normal, change = _normal_sweep(c, vw, push, normal, target)
-        if full and change < CONVERGED:
-            break
+    normal, tangential = sweeps(c, vw, imp.normal.copy(), tangential, target, iterations,
+                                friction_every=friction_every, converge=True)  # fmt: skip
     v[c.balls] = vw[:3].T
     w[c.balls] = vw[3:].T
     v[-1] = 0.0
@@ -137,15 +141,65 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     return imp
 
 
-def _normal_sweep(c: _Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray,
-                  target: np.ndarray) -> tuple[np.ndarray, float]:  # fmt: skip
+def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarray | None,
+           target: np.ndarray, count: int, *, friction_every: int | None = None,
+           m_n: np.ndarray | None = None, give: np.ndarray | float | None = None,
+           converge: bool = False) -> tuple[np.ndarray, np.ndarray | None]:  # fmt: skip
+    """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
+    and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
+    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses.
+
+    Every ``friction_every``-th sweep and the last also update friction and rolling resistance (None:
+    normal impulses alone). ``m_n`` and ``give`` make the normal soft (``contact_model.normal_impulse``;
+    the soft step); ``converge`` stops after a full sweep that changed no contact velocity by more
+    than CONVERGED."""
+    m_n = c.m_n if m_n is None else m_n
+    push = np.empty((6 if friction_every else 3, 2 * c.k))  # what each contact adds to its a, then its b
+    motion = np.empty((2, 3, c.k)) if friction_every else None  # slip at the contact point; relative spin
+    for sweep in range(count):
+        full = friction_every is not None and ((sweep + 1) % friction_every == 0 or sweep == count - 1)
+        if not full:
+            normal = _normal_sweep(c, vw, push, normal, target, m_n, give)
+            continue
+        normal, tangential, change = _full_sweep(c, vw, push, normal, tangential, target, motion, m_n, give,
+                                                 converge)  # fmt: skip
+        if converge and change < CONVERGED:
+            break
+    return normal, tangential
+
+
+def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None) -> np.ndarray:
+    """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it on
+    spheres), against a moving plane's ``surface``."""
+    g = np.take(v[:3], c.ends, axis=1)
+    return model.normal_speed(g[:, : c.k], g[:, c.k :], n, surface)
+
+
+def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray) -> None:
+    """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both balls
+    of every contact (``contact_model``: Δv = ±m⁻¹·(P_n·n + P_t), Δω = I⁻¹·(−ρ·n × P_t ± R));
+    ``push`` (6, 2K) is scratch."""
+    k = c.k
+    d_t, d_r = tangential[0], tangential[1]
+    linear = normal * c.n + d_t
+    turn = model.turn(c.n, d_t)
+    push[:3, :k] = linear
+    np.negative(linear, out=push[:3, k:])
+    np.multiply(turn, c.minus_ra, out=push[3:, :k])
+    push[3:, :k] += d_r
+    np.multiply(turn, c.minus_rb, out=push[3:, k:])
+    push[3:, k:] -= d_r
+    total = c.add_up(push)
+    total *= c.inverse
+    vw += total
+
+
+def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, target: np.ndarray,
+                  m_n: np.ndarray, give: np.ndarray | float | None) -> np.ndarray:  # fmt: skip
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
-    g = np.take(vw[:3], c.ends, axis=1)
-    vn = np.einsum("ij,ij->j", g[:, :k] - g[:, k:], n)
-    if c.moving:  # relative to a moving plane's surface
-        vn -= np.einsum("ij,ij->j", c.surface, n)
-    new = np.maximum(normal + c.m_n * (target - vn), 0.0)
+    vn = normal_speeds(c, vw, n, c.surface if c.moving else None)
+    new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     lin = push[:3]
     np.multiply(d_n, n, out=lin[:, :k])
@@ -153,58 +207,34 @@ def _normal_sweep(c: _Contacts, vw: np.ndarray, push: np.ndarray, normal: np.nda
     total = c.add_up(lin)
     total *= c.inverse[:3]
     vw[:3] += total
-    return new, float(np.abs(d_n).max()) * c.inv_m_n
+    return new
 
 
-def _full_sweep(c: _Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
-                target: np.ndarray, motion: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:  # fmt: skip
-    """One sweep of normal, friction and rolling impulses; ``vw`` changes in place."""
-    k, n, nx = c.k, c.n, c.nx
+def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
+                target: np.ndarray, motion: np.ndarray, m_n: np.ndarray, give: np.ndarray | float | None,
+                measure: bool) -> tuple[np.ndarray, np.ndarray, float]:  # fmt: skip
+    """One sweep of normal, friction and rolling impulses, all from the velocities at its start;
+    ``vw`` changes in place. Returns the impulses and (when ``measure``) a bound on the largest
+    velocity change it made at any contact (m/s)."""
+    k, n = c.k, c.n
     g = np.take(vw, c.ends, axis=1)
     va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
-    # contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b)
-    arm_spin = g[3:] * c.arms
-    rel = va - vb
-    rel += np.einsum("ijk,jk->ik", nx, arm_spin[:, :k] + arm_spin[:, k:])
-    if c.moving:  # relative to a moving plane's surface
-        rel -= c.surface
-    vn = np.einsum("ij,ij->j", rel, n)
-
-    # normal: the accumulated impulse stays ≥ 0
-    new = np.maximum(normal + c.m_n * (target - vn), 0.0)
+    rel = model.contact_velocity(va, wa, vb, wb, n, c.ra, c.rb, c.surface if c.moving else None)
+    vn = model.dot(rel, n)
+    new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
-    linear = d_n * n
-    change = float(np.abs(d_n).max()) * c.inv_m_n
-
-    # friction cancels slip inside the Coulomb cone |P_t| ≤ μ·P_n; rolling resistance opposes
-    # relative spin up to ρ·r·P_n
+    # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
     np.subtract(wa, wb, out=motion[1])
     if c.moving:
         motion[1] -= c.spin
-    candidate = tangential - c.m_tr * motion
-    length = np.einsum("ijk,ijk->ik", candidate, candidate)
-    length += 1e-300  # no 0/0 at zero
-    np.sqrt(length, out=length)
-    scale = np.minimum(c.limits * new / length, 1.0)
-    new_tr = candidate * scale[:, None, :]
+    new_tr = model.within_limit(tangential - c.m_tr * motion, c.limits * new)
     d_tr = new_tr - tangential
-    d_t, d_r = d_tr[0], d_tr[1]
-    linear += d_t
-    turn = np.einsum("ijk,jk->ik", nx, d_t)  # n × ΔP_t
-    push_a, push_b = push[3:, :k], push[3:, k:]
-    np.multiply(turn, c.minus_ra, out=push_a)
-    push_a += d_r
-    np.multiply(turn, c.minus_rb, out=push_b)
-    push_b -= d_r
-    change = max(change, float(np.abs(d_t).max()) * c.inv_m_t)
-
-    push[:3, :k] = linear
-    np.negative(linear, out=push[:3, k:])
-    total = c.add_up(push)
-    total *= c.inverse
-    vw += total
+    apply(c, vw, push, d_n, d_tr)
+    change = 0.0
+    if measure:
+        change = max(float(np.abs(d_n).max()) * c.inv_m_n, float(np.abs(d_tr[0]).max()) * c.inv_m_t)
     return new, new_tr, change
 
 
@@ -213,17 +243,17 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
     proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world."""
-    e = _Ends(a, b, 3)  # rows x, y, z
+    e = Ends(a, b, 3)  # rows x, y, z
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
     wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
-    fa, fb = wa / (wa + wb), -wb / (wa + wb)  # each end's part of the contact's correction
+    fa, fb = model.separation_parts(wa, wb)  # each end's part of the contact's correction
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
-    start = np.einsum("ij,ij->j", n, np.take(x, ends[:k], axis=1) - np.take(x, ends[k:], axis=1))
+    start = model.dot(n, np.take(x, ends[:k], axis=1) - np.take(x, ends[k:], axis=1))
     move = np.zeros((3, 2 * k))
     for _ in range(sweeps):
         g = np.take(x, ends, axis=1)
-        now = gap + np.einsum("ij,ij->j", n, g[:, :k] - g[:, k:]) - start
+        now = gap + model.dot(n, g[:, :k] - g[:, k:]) - start
         d = np.maximum(-now, 0.0) * n
         np.multiply(d, fa, out=move[:, :k])
         np.multiply(d, fb, out=move[:, k:])

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, jacobi
+from . import contact_model, exact, jacobi
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
@@ -40,15 +40,15 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
 def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) -> None:
     """Gauss–Seidel sweeps over the contact colours; ``pos`` (N+1, 3) changes in place."""
     n = c.normal
-    offset = np.einsum("ij,ij->i", n, pos[c.a] - pos[c.b]) - c.gap
-    share = rows.inv_mass_a / (rows.inv_mass_a + rows.inv_mass_b)
+    offset = exact.dot(n, pos[c.a] - pos[c.b]) - c.gap
+    part_a, part_b = contact_model.separation_parts(rows.inv_mass_a, rows.inv_mass_b)
     for _ in range(PENETRATION_SWEEPS):
         for idx in rows.colours:
             a, b = c.a[idx], c.b[idx]
-            gap = np.einsum("ij,ij->i", n[idx], pos[a] - pos[b]) - offset[idx]
+            gap = exact.dot(n[idx], pos[a] - pos[b]) - offset[idx]
             depth = np.maximum(-gap, 0.0)[:, None] * n[idx]
-            pos[a] += depth * share[idx, None]
-            pos[b] -= depth * (1.0 - share[idx, None])
+            pos[a] += depth * part_a[idx, None]
+            pos[b] += depth * part_b[idx, None]
         pos[-1] = 0.0
 
 
@@ -68,7 +68,7 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray) -
     if lift <= 0.0:
         return
     v = state.body[moved, V]
-    kinetic = 0.5 * exact.total(mass * np.einsum("ij,ij->i", v, v))
+    kinetic = 0.5 * exact.total(mass * exact.dot(v, v))
     scale = np.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
     state.body[moved, V] = v * scale
 

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import solver
+from . import exact, solver
+from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows, rows_at_end
 from .settings import JACOBI_FROM, WARM_START_SPAN
-from .solver import Impulses
 from .state import State, V, W, with_static
 
 
@@ -43,9 +43,7 @@ class WarmStart:
         imp.normal[found] = self.forces.normal[src] * h
         friction = self.forces.friction[src] * h
         n = normal[found]
-        imp.friction[found] = (
-            friction - np.einsum("ij,ij->i", friction, n)[:, None] * n
-        )  # onto today's tangent plane
+        imp.friction[found] = friction - exact.dot(friction, n)[:, None] * n  # onto today's tangent plane
         imp.rolling[found] = self.forces.rolling[src] * h
         return imp
 

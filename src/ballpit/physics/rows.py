@@ -16,8 +16,8 @@ from functools import cached_property
 import numpy as np
 
 from . import exact, moving_planes
+from .contact_model import Impulses
 from .contacts import SPHERE_PLANE, ContactPoints, take_indices
-from .impulses import Impulses
 from .model import Model
 from .state import State
 
@@ -49,7 +49,7 @@ class ContactRows:
     def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side."""
         a, b = self.arm_a[idx], self.arm_b[idx]
-        return np.sqrt(np.einsum("ij,ij->i", a, a)), np.sqrt(np.einsum("ij,ij->i", b, b))
+        return exact.norm(a), exact.norm(b)
 
     @cached_property
     def colours(self) -> list[np.ndarray]:

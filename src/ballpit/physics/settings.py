@@ -136,7 +136,7 @@ BOUNCE_JACOBI_SWEEPS = 1
 # (rounding, not an impact).
 APPROACH_SPEED = 1e-6
 
-# --- Contact solves (solver.py, jacobi.py, impulses.py, resting.py) ---------------------------------
+# --- Contact solves (solver.py, jacobi.py, resting.py; the contact model is contact_model.py) ---------
 
 # Default of ``World.solver_iterations``: projected Gauss–Seidel sweeps per solve.
 SOLVER_ITERATIONS = 10

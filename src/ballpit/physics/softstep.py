@@ -27,8 +27,11 @@ start. Balls that touch no contact of the frame are left to the world's integrat
 its textbook accuracy); see ``strategies.crowded_step`` for when a frame is taken this way at all and
 how its result is checked.
 
-Every sweep updates all contacts at once (projected Jacobi with mass splitting, ``jacobi.py``): a
-substep costs a fixed number of array passes, however many colours a pile would need.
+Every sweep updates all contacts at once (projected Jacobi with mass splitting, ``jacobi.py``, over
+the contact model of contact_model.py): a substep costs a fixed number of array passes, however many
+colours a pile would need. Each ball's mass is split only among its contacts that can push this
+substep: a speculative contact still far from closing takes no share, so it does not soften the ones
+that carry the load.
 """
 
 from __future__ import annotations
@@ -39,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import jacobi, penetration, quaternion
+from .contact_model import Impulses, dot
 from .contacts import ContactPoints
 from .forces import ConstantPerBall, ForceTerm, constant_acceleration
-from .impulses import Impulses
 from .rows import ContactRows, contact_rows
 from .settings import (
     CONTACT_HERTZ,
@@ -54,31 +57,6 @@ from .settings import (
     SOLVE_SWEEPS,
 )
 from .state import Q, V, W, X, with_static
-
-
-class _Rows(jacobi._Contacts):
-    """The frame's contacts as the Jacobi sweeps take them (``jacobi._Contacts``), with each ball's
-    mass split only among its contacts that can push this substep (``share``): a speculative contact
-    still far from closing takes no share, so it does not soften the ones that carry the load."""
-
-    def __init__(self, rows: ContactRows) -> None:
-        super().__init__(rows)
-        self.ima, self.imb = rows.inv_mass_a, rows.inv_mass_b
-        self.iia, self.iib = rows.inv_inertia_a, rows.inv_inertia_b
-        ra, rb = -self.minus_ra, -self.minus_rb
-        self.ra2, self.rb2 = ra * ra, rb * rb
-        self.whole = self.ima + self.imb  # 1/m_n of the unsplit balls
-
-    def share_among(self, active: np.ndarray) -> None:
-        """Split each ball's mass among its ``active`` contacts (at least one share each)."""
-        k = self.k
-        counts = np.bincount(self.ends, weights=np.concatenate((active, active)), minlength=self.m)
-        share = np.maximum(counts, 1.0)
-        sa, sb = share[self.ends[:k]], share[self.ends[k:]]
-        self.m_n = 1.0 / (sa * self.ima + sb * self.imb)
-        m_t = 1.0 / (sa * (self.ima + self.ra2 * self.iia) + sb * (self.imb + self.rb2 * self.iib))
-        m_r = 1.0 / np.maximum(sa * self.iia + sb * self.iib, 1e-300)
-        self.m_tr = np.stack((m_t, m_r))[:, None, :]
 
 
 @dataclass(frozen=True)
@@ -123,7 +101,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     h = dt / substeps
     n_balls = model.spheres.count
     rows = contact_rows(model, state, c)
-    k = _Rows(rows)
+    k = jacobi.Contacts(rows)
     body = state.body
     balls = k.balls
     m_dyn = int(np.searchsorted(balls, n_balls))  # the static row N, if there, is the last column
@@ -145,7 +123,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     ends_a, ends_b = k.ends[:kc], k.ends[kc:]
     on_plane = rows.b == n_balls
     # the surface's own speed along the normal (moving planes), to move their side of s
-    surface_n = _dot(k.surface, n) if k.moving else None
+    surface_n = dot(k.surface, n) if k.moving else None
     hertz = min(CONTACT_HERTZ, 0.25 / h)
     ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
     bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
@@ -158,8 +136,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     apart = warm.apart_of(keys)
     normal = imp.normal.copy()
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-    push = np.zeros((6, 2 * kc))
-    motion = np.empty((2, 3, kc))
+    push = np.empty((6, 2 * kc))
     total = np.zeros(kc)
     least = c.gap.copy()
     largest = np.zeros(m)
@@ -171,18 +148,15 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         vw[:3, live] += lin * h
         vw[3:, live] += ang * h
         # 2. warm start
-        _apply(k, vw, push, normal, tangential)
+        jacobi.apply(k, vw, push, normal, tangential)
         # 3. solve with the soft bias
         s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, i * h)
         # the contacts that can push this substep: pressed already, or closing faster than their gap
-        k.share_among((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
+        k.split((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
         speculative = s > 0.0
         target = np.where(speculative, -s / h, np.minimum(-bias_rate * (s - apart), MAX_PUSH))
-        scale = np.where(speculative, 1.0, mass_scale)
-        keep = np.where(speculative, 0.0, impulse_scale)
-        normal, tangential = _sweeps(
-            k, vw, push, normal, tangential, target, scale, keep, motion, SOLVE_SWEEPS
-        )
+        scale, give = np.where(speculative, 1.0, mass_scale), np.where(speculative, 0.0, impulse_scale)
+        normal, tangential = _soft_sweeps(k, vw, normal, tangential, target, scale, give, SOLVE_SWEEPS)
         # 4. integrate positions (and orientations)
         before = x[:, live].copy()
         x[:, live] += vw[:3, live] * h
@@ -191,7 +165,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, (i + 1) * h)
         np.minimum(least, s, out=least)
         target = np.where(s > 0.0, -s / h, 0.0)
-        normal, tangential = _sweeps(k, vw, push, normal, tangential, target, 1.0, 0.0, motion, RELAX_SWEEPS)
+        normal, tangential = _soft_sweeps(k, vw, normal, tangential, target, 1.0, 0.0, RELAX_SWEEPS)
         total += normal
         # what the checks need: how far each ball got, and where
         moved = x[:, live] - before
@@ -268,7 +242,7 @@ def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.
     least[on] = np.minimum(least[on], s + deficit)
 
 
-def restitution_pass(rows: ContactRows, k: jacobi._Contacts, vw: np.ndarray, normal: np.ndarray,
+def restitution_pass(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray,
                      vn_start: np.ndarray, threshold: float, pressed: np.ndarray) -> np.ndarray:  # fmt: skip
     """Box2D's restitution: each contact that closed faster than ``threshold`` when the frame began
     (``vn_start``) and pushed during it (``pressed``) is driven to leave at e times that speed,
@@ -282,24 +256,12 @@ def restitution_pass(rows: ContactRows, k: jacobi._Contacts, vw: np.ndarray, nor
     bouncing = np.flatnonzero(pressed & (vn_start < -threshold) & (rows.restitution > 0.0))
     if bouncing.size == 0:
         return added
-    sub = jacobi._Contacts(rows.subset(bouncing))
+    sub = jacobi.Contacts(rows.subset(bouncing))
     cols = np.searchsorted(k.balls, sub.balls)  # the bouncing balls among the frame's columns
     v = vw[:3, cols]
     target = -rows.restitution[bouncing] * vn_start[bouncing]
     start = normal[bouncing]
-    acc = start.copy()
-    lin = np.empty((3, 2 * sub.k))
-    for _ in range(RESTITUTION_SWEEPS):
-        g = np.take(v, sub.ends, axis=1)
-        vn = _dot(g[:, : sub.k] - g[:, sub.k :], sub.n)
-        if sub.moving:
-            vn -= _dot(sub.surface, sub.n)
-        new = np.maximum(acc + sub.m_n * (target - vn), 0.0)
-        d_n = new - acc
-        acc = new
-        np.multiply(d_n, sub.n, out=lin[:, : sub.k])
-        np.negative(lin[:, : sub.k], out=lin[:, sub.k :])
-        v += sub.add_up(lin) * sub.inverse[:3]
+    acc, _ = jacobi.sweeps(sub, v, start.copy(), None, target, RESTITUTION_SWEEPS)
     vw[:3, cols] = v
     added[bouncing] = acc - start
     return added
@@ -329,28 +291,27 @@ def _accelerations(terms, constant, x: np.ndarray, vw: np.ndarray, q: np.ndarray
     return lin.T, ang.T
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Column-wise dot products of (3, K) arrays, summed x, y, z in that order."""
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def _normal_speed(k: jacobi.Contacts, vw: np.ndarray) -> np.ndarray:
+    """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
+    against a moving plane's surface."""
+    return jacobi.normal_speeds(k, vw, k.n, k.surface if k.moving else None)
 
 
 def _length(a: np.ndarray) -> np.ndarray:
-    return np.sqrt(_dot(a, a))
+    return np.sqrt(dot(a, a))
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Column-wise a × b of (3, K) arrays."""
-    return np.stack((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
+def _soft_sweeps(k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
+                 target: np.ndarray, scale: np.ndarray | float, give: np.ndarray | float,
+                 sweeps: int) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """``sweeps`` Jacobi sweeps of the soft normal update ΔP = m_n·scale·(target − v_n) − give·P (P ≥ 0);
+    the last one also updates friction (the Coulomb cone |P_t| ≤ μ·P_n) and rolling resistance
+    (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses.
 
-
-def _normal_speed(k: jacobi._Contacts, vw: np.ndarray) -> np.ndarray:
-    """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
-    against a moving plane's surface."""
-    g = np.take(vw[:3], k.ends, axis=1)
-    vn = _dot(g[:, : k.k] - g[:, k.k :], k.n)
-    if k.moving:
-        vn -= _dot(k.surface, k.n)
-    return vn
+    The spring's give, −give·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
+    give·P/m_whole), so a ball's share of a crowd does not make its contacts softer."""
+    return jacobi.sweeps(k, vw, normal, tangential, target, sweeps, friction_every=sweeps,
+                         m_n=k.m_n * scale, give=give * k.m_n * k.whole)  # fmt: skip
 
 
 def _separation(s0: np.ndarray, n: np.ndarray, x: np.ndarray, x0: np.ndarray, ends_a: np.ndarray,
@@ -358,77 +319,10 @@ def _separation(s0: np.ndarray, n: np.ndarray, x: np.ndarray, x0: np.ndarray, en
     """s = s₀ + n·(Δx_a − Δx_b): the separation from the balls' moved positions (and a moving plane's
     surface, moved by its speed along n for ``t``)."""
     d = x - x0
-    s = s0 + _dot(np.take(d, ends_a, axis=1) - np.take(d, ends_b, axis=1), n)
+    s = s0 + dot(np.take(d, ends_a, axis=1) - np.take(d, ends_b, axis=1), n)
     if surface_n is not None:
         s -= surface_n * t
     return s
-
-
-def _apply(k: jacobi._Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray,
-           tangential: np.ndarray) -> None:  # fmt: skip
-    """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both
-    balls of every contact: Δv = ±m⁻¹·P, Δω = −ρ·I⁻¹·(n × P_t) ± I⁻¹·R."""
-    kc = k.k
-    d_t, d_r = tangential[0], tangential[1]
-    linear = normal * k.n + d_t
-    turn = _cross(k.n, d_t)
-    push[:3, :kc] = linear
-    np.negative(linear, out=push[:3, kc:])
-    np.multiply(turn, k.minus_ra, out=push[3:, :kc])
-    push[3:, :kc] += d_r
-    np.multiply(turn, k.minus_rb, out=push[3:, kc:])
-    push[3:, kc:] -= d_r
-    total = k.add_up(push)
-    total *= k.inverse
-    vw += total
-
-
-def _sweeps(k: jacobi._Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
-            target: np.ndarray, scale, keep, motion: np.ndarray,
-            sweeps: int) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """``sweeps`` Jacobi sweeps of the soft normal update ΔP = m_n·scale·(target − v_n) − keep·P
-    (P ≥ 0); the last one also updates friction (the Coulomb cone |P_t| ≤ μ·P_n) and rolling
-    resistance (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses."""
-    kc, n = k.k, k.n
-    m_n = k.m_n * scale
-    # The spring's give, −keep·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
-    # keep·P/m_whole), so a ball's share of a crowd does not make its contacts softer.
-    keep = keep * k.m_n * k.whole
-    for sweep in range(sweeps):
-        if sweep < sweeps - 1:  # normal impulses alone: only the linear velocities matter
-            vn = _normal_speed(k, vw)
-            new = np.maximum(normal + m_n * (target - vn) - keep * normal, 0.0)
-            d_n = new - normal
-            normal = new
-            lin = push[:3]
-            np.multiply(d_n, n, out=lin[:, :kc])
-            np.negative(lin[:, :kc], out=lin[:, kc:])
-            vw[:3] += k.add_up(lin) * k.inverse[:3]
-            continue
-        g = np.take(vw, k.ends, axis=1)
-        va, wa, vb, wb = g[:3, :kc], g[3:, :kc], g[:3, kc:], g[3:, kc:]
-        # contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b)
-        arm_spin = g[3:] * k.arms
-        rel = va - vb + _cross(n, arm_spin[:, :kc] + arm_spin[:, kc:])
-        if k.moving:
-            rel -= k.surface
-        vn = _dot(rel, n)
-        new = np.maximum(normal + m_n * (target - vn) - keep * normal, 0.0)
-        d_n = new - normal
-        normal = new
-        # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
-        motion[0] = rel - vn * n
-        motion[1] = wa - wb
-        if k.moving:
-            motion[1] -= k.spin
-        candidate = tangential - k.m_tr * motion
-        length = np.sqrt(candidate[:, 0] * candidate[:, 0] + candidate[:, 1] * candidate[:, 1]
-                         + candidate[:, 2] * candidate[:, 2] + 1e-300)  # fmt: skip
-        new_tr = candidate * np.minimum(k.limits * normal / length, 1.0)[:, None, :]
-        d_tr = new_tr - tangential
-        tangential = new_tr
-        _apply(k, vw, push, d_n, d_tr)
-    return normal, tangential
 
 
 def _turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
@@ -457,7 +351,7 @@ def hold_energy(model, state, before: np.ndarray, balls: np.ndarray) -> None:
 
     def energy(rows: np.ndarray) -> tuple[float, float]:
         v, w, x = rows[:, V], rows[:, W], rows[:, X]
-        kinetic = 0.5 * (mass * _dot(v.T, v.T) + inertia * _dot(w.T, w.T))
+        kinetic = 0.5 * (mass * dot(v.T, v.T) + inertia * dot(w.T, w.T))
         potential = -mass * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
         return float(np.cumsum(kinetic)[-1]), float(np.cumsum(potential)[-1])
 

@@ -1,0 +1,140 @@
+"""The contact model, written once: how an impulse at a contact changes two balls' motion, and how
+each part of it is bounded. Every solve builds on these functions (solver.py: Gauss–Seidel colour by
+colour; jacobi.py: every contact at once, which the soft step's substeps and restitution also run;
+impacts.py: bounces in waves); the solves differ only in the order they update the contacts.
+
+A contact joins ball a to b (another ball, or the static row N for a plane) along its unit normal n,
+pointing towards a. With ρ_a and ρ_b the radii (ρ_b = 0 on a plane), the lever arms are r_a = −ρ_a·n
+and r_b = +ρ_b·n (Catto, "Iterative Dynamics with Temporal Coherence", GDC 2005; Box2D's
+contact_solver.c):
+
+- contact-point velocity of a relative to b: v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b), less the surface
+  velocity of a moving plane under the point;
+- normal impulse P_n ≥ 0, effective mass m_n = 1/(1/m_a + 1/m_b): a sphere's lever arm is parallel to
+  n, so spin never changes the normal speed v_n;
+- friction P_t in the tangent plane, inside the Coulomb cone |P_t| ≤ μ·P_n, with the isotropic
+  effective mass m_t = 1/(1/m_a + ρ_a²/I_a + 1/m_b + ρ_b²/I_b) (r is perpendicular to any tangent);
+- rolling resistance R, an angular impulse opposing relative spin, |R| ≤ ρ_roll·P_n, with
+  m_r = 1/(1/I_a + 1/I_b); on level ground it slows a rolling ball at (5/7)·ρ_roll·g;
+- an impulse changes the balls by Δv_a = (P_n·n + P_t)/m_a, Δω_a = (−ρ_a·n × P_t + R)/I_a, and the
+  opposite on b: Δv_b = −(P_n·n + P_t)/m_b, Δω_b = (−ρ_b·n × P_t − R)/I_b;
+- a soft normal (Catto, "Soft constraints", GDC 2011; the soft step) gives way in proportion to the
+  impulse it carries: ΔP_n = m_n·s·(target − v_n) − k·P_n, with mass scale s and impulse scale k.
+
+Material mixing (e = e_a·e_b, μ = √(μ_a·μ_b), ρ_roll = √(ρ_a·ρ_b) times the rolling radius) is done once
+per contact in rows.py. Per-contact vectors here are (3, K) columns, one contact a column, and every
+sum over x, y, z is taken from first to last, so each solve gives the same bits on any CPU (exact.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Impulses:
+    """Accumulated impulses per contact, as the warm start keeps them: normal (K,), friction (K, 3),
+    rolling (K, 3)."""
+
+    normal: np.ndarray
+    friction: np.ndarray
+    rolling: np.ndarray
+
+    @staticmethod
+    def zeros(count: int) -> Impulses:
+        return Impulses(np.zeros(count), np.zeros((count, 3)), np.zeros((count, 3)))
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise a · b of (3, K) arrays, summed x, y, z in that order."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise a × b of (3, K) arrays (each component as ``np.cross`` forms it)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
+    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
+    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
+    return out
+
+
+def inverse_effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv_inertia_a: np.ndarray,
+                             inv_inertia_b: np.ndarray, arm_a: np.ndarray,
+                             arm_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """1/m_n, 1/m_t and 1/m_r of contacts whose balls have these inverse masses and inertias (each
+    already multiplied by the ball's number of contacts where the mass is split, jacobi.py) and
+    lever-arm lengths: how much a unit impulse changes the normal speed, the slip and the spin."""
+    inv_n = inv_mass_a + inv_mass_b
+    inv_t = inv_mass_a + arm_a**2 * inv_inertia_a + inv_mass_b + arm_b**2 * inv_inertia_b
+    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, 1e-300)
+    return inv_n, inv_t, inv_r
+
+
+def effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv_inertia_a: np.ndarray,
+                     inv_inertia_b: np.ndarray, arm_a: np.ndarray,
+                     arm_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """The normal, tangential (friction) and angular (rolling resistance) effective masses m_n, m_t
+    and m_r (see ``inverse_effective_masses``)."""
+    inv_n, inv_t, inv_r = inverse_effective_masses(inv_mass_a, inv_mass_b, inv_inertia_a, inv_inertia_b,
+                                                   arm_a, arm_b)  # fmt: skip
+    return 1.0 / inv_n, 1.0 / inv_t, 1.0 / inv_r
+
+
+def contact_velocity(v_a: np.ndarray, w_a: np.ndarray, v_b: np.ndarray, w_b: np.ndarray, n: np.ndarray,
+                     arm_a: np.ndarray, arm_b: np.ndarray,
+                     surface: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """The contact point's velocity of a relative to b, v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b), less the
+    ``surface`` velocity of a moving plane (all (3, K); ρ the lever-arm lengths, (K,))."""
+    rel = v_a - v_b + cross(n, arm_a * w_a + arm_b * w_b)
+    if surface is not None:
+        rel -= surface
+    return rel
+
+
+def normal_speed(
+    v_a: np.ndarray, v_b: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None
+) -> np.ndarray:
+    """Each contact's normal speed v_n = (v_a − v_b)·n (negative: closing), against a moving plane's
+    ``surface``; spin never changes it on spheres (a lever arm is parallel to n)."""
+    v_n = dot(v_a - v_b, n)
+    if surface is not None:
+        v_n -= dot(surface, n)
+    return v_n
+
+
+def normal_impulse(accumulated: np.ndarray, m_n: np.ndarray, target: np.ndarray, v_n: np.ndarray,
+                   give: np.ndarray | float | None = None) -> np.ndarray:  # fmt: skip
+    """The new accumulated normal impulse that drives v_n towards ``target``, kept ≥ 0 (a contact
+    pushes, never pulls): P + m_n·(target − v_n), less ``give``·P for a soft contact (m_n then carries
+    the mass scale, ``give`` is the impulse scale k)."""
+    new = accumulated + m_n * (target - v_n)
+    if give is not None:
+        new -= give * accumulated
+    return np.maximum(new, 0.0, out=new)
+
+
+def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """``candidate`` impulses (vectors along the second-to-last axis of length 3: (3, K) or stacked
+    (2, 3, K)) scaled down to length ≤ ``limit``: the friction cone μ·P_n, or the rolling limit."""
+    x, y, z = candidate[..., 0, :], candidate[..., 1, :], candidate[..., 2, :]
+    length = x * x + y * y + z * z
+    length += 1e-300  # no 0/0 at zero
+    np.sqrt(length, out=length)
+    scale = np.minimum(limit / length, 1.0)
+    return candidate * scale[..., None, :]
+
+
+def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How an overlap moving apart by positions is shared: a moves along n by its part of the overlap
+    and b by its (negative) part, each in proportion to its inverse mass (split, in jacobi.py), so the
+    lighter ball moves farther and a plane (inverse mass 0) not at all."""
+    total = inv_mass_a + inv_mass_b
+    return inv_mass_a / total, -inv_mass_b / total
+
+
+def turn(n: np.ndarray, tangential: np.ndarray) -> np.ndarray:
+    """n × P_t: what a tangential impulse at the contact turns each ball by, times −ρ/I."""
+    return cross(n, tangential)
