@@ -7,6 +7,8 @@ point; ``ScreenOverlay`` owns the labels and turns pointer events on the bar int
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pyglet
 
@@ -25,6 +27,8 @@ BAR_KEPT = (0.3, 0.42, 0.6, 0.9)
 BAR_DONE = (0.45, 0.7, 1.0, 0.95)
 BAR_CURSOR = (1.0, 1.0, 1.0, 1.0)
 FONT_SIZE = 10
+LABEL_INTERVAL = 0.1  # s: the bar's label is laid out again at most this often (as the HUD's text);
+# at every frame its time, new each frame, cost about 1 ms of the window's thread (pyglet's layout)
 
 
 def timeline_bar(width: int) -> tuple[float, float, float, float]:
@@ -69,6 +73,7 @@ class ScreenOverlay:
         self.bar_label = pyglet.text.Label(
             "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, anchor_x="right", anchor_y="bottom"
         )
+        self._label_at = 0.0  # when the bar's label may change next
         self.plot_labels: list[pyglet.text.Label] = []
         self.plot_batch = pyglet.graphics.Batch()
 
@@ -120,8 +125,10 @@ class ScreenOverlay:
         if bar is not None:
             triangles.append(bar_shapes(width, bar.fraction))
             text = f"{bar.kind}  {bar.now:.3f} s of {bar.oldest:.2f}–{bar.newest:.2f} s  (drag to scrub)"
-            if self.bar_label.text != text:
+            now = time.perf_counter()
+            if self.bar_label.text != text and now >= self._label_at:
                 self.bar_label.text = text
+                self._label_at = now + LABEL_INTERVAL
             self.bar_label.x = width - BAR_MARGIN
             self.bar_label.y = BAR_MARGIN + BAR_HEIGHT + BAR_LABEL_GAP
         if self.show_plot and shown.energy is not None:
