@@ -7,6 +7,7 @@ The physics runs beside the window on a thread of its own (stepper.py): the wind
 state it handed over and sends it what the keys and the mouse ask as commands, applied between steps.
 In pyglet's loop (``frame()`` without ``dt``) the physics runs free on the wall clock; a frame given a
 ``dt`` advances it by exactly that much first (lockstep), which is what tests and scripts use.
+pyglet's loop draws at the rate pacing.py chooses: 60 FPS, or 33 while the physics needs the CPU.
 """
 
 from __future__ import annotations

@@ -14,19 +14,27 @@ Two ways to run:
 
 - free (``run_free``): the thread steps on the wall clock, through ``Simulation.advance`` (a fixed
   timestep from an accumulator; when a step costs more than real time the backlog is dropped, so the
-  HUD's real-time factor is simulated seconds over wall seconds, as measured);
+  HUD's real-time factor is simulated seconds over wall seconds, as measured). Between batches it
+  sleeps until the next step is due, counting the batch's own time as passed: a batch that ran late
+  is followed by the next at once (timed from the batch's start, pile.toml's 15-20 ms frames of 1/60 s
+  slept away a fifth of the wall time while the pile landed). ``busy_fraction`` says how much of the
+  last half second it did not sleep by choice; the window draws less while it is near 1 (pacing.py);
 - lockstep (``advance(dt)``): the caller's thread takes the lock and advances exactly ``dt`` of real
   time, applying the commands first. Tests and scripted runs use it for exact, repeatable frames.
 
-A thread rather than a process, by the figures of benchmarks/physics_beside_drawing.py on a 2-core
-machine with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s
-with the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17
-and 17); with slopes.toml stepping flat out, 15 and 19 frames/s against 16 and 16 (194 and 225 steps/s
-against 177 and 182). A process buys nothing here: the two cores are shared with llvmpipe's own
-threads either way, and the GL driver and NumPy's large operations release the GIL. A thread keeps
-every World-touching feature (history, ghosts, recording, picking, saving) in one address space with
-plain function calls as commands. The GIL switch interval is lowered while it runs so the window,
-coming back from a GL call, waits at most about a millisecond for the physics to let go.
+A thread rather than a process. First by benchmarks/physics_beside_drawing.py on a 2-core machine
+with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s with
+the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17 and
+17); with slopes.toml stepping flat out, 15 and 19 frames/s against 16 and 16 (194 and 225 steps/s
+against 177 and 182). Then, with the physics near real time (1/60 s frames, later that day), by the
+physics thread's own clocks in benchmarks/viewer_window_fps.py --threads: while pile.toml lands beside
+the window it is asleep about 2 % of the wall time beyond the sleeps it chose, which bounds what it
+waits for the GIL; the rest is on a core (55-65 %) or waiting for one (30-40 %, the machine shared),
+and it spends as much CPU per simulated second as headless. What it lacks is CPU, not the GIL, and a
+process would share the same cores (and, with the kernel's autogroups, the same share of them). A
+thread keeps every World-touching feature (history, ghosts, recording, picking, saving) in one address
+space with plain function calls as commands. The GIL switch interval is lowered while it runs so the
+window, coming back from a GL call, waits at most about a millisecond for the physics to let go.
 """
 
 from __future__ import annotations
