@@ -508,13 +508,16 @@ def escape_mid_step(workdir: Path) -> dict:
 
 
 def pacing(workdir: Path) -> dict:
-    """pyglet's own loop (``Viewer.run``, as ``ballpit view``) on balls whose every step takes 30 ms of
-    wall time, far behind real time, then paused: the redraw interval the window schedules and the
-    frames it draws in a second each way."""
+    """pyglet's own loop (``Viewer.run``, as ``ballpit view``) on balls in 1/60 s steps that each take
+    30 ms of wall time (about half real time), then paused: the redraw interval the window schedules
+    and the frames it draws in a second each way."""
     import pyglet
     from pyglet.window import key
 
-    viewer = Viewer(size=(320, 180), world=balls_world())
+    from ballpit.scene import Scene, default_appearance
+
+    world = balls_world()
+    viewer = Viewer(size=(320, 180), world=Scene(world, default_appearance(world), timestep=1.0 / 60.0))
     OPENED.append(viewer)
     viewer.sim.before_step.append(lambda: time.sleep(0.03))
     out: dict = {}
@@ -528,6 +531,7 @@ def pacing(workdir: Path) -> dict:
     def seen(name: str) -> None:
         frames, at = marks.pop(name)
         out[name] = {"interval": viewer._interval, "busy": viewer.physics.busy_fraction,
+                     "pace": viewer.physics.pace,
                      "fps": (viewer.frames - frames) / (time.perf_counter() - at)}  # fmt: skip
 
     def script(_dt: float) -> None:

@@ -566,7 +566,7 @@ class Viewer:
         self.window.draw(dt)
         clock = self._pyglet.clock.get_default()
         now = clock.time()
-        self._interval = interval = self.pacer.interval(self.physics.busy_fraction)
+        self._interval = interval = self.pacer.interval(self.physics.busy_fraction, self.physics.pace)
         due = (now if self._due is None else self._due) + interval
         self._due = due if due > now else now  # more than a frame late: do not try to catch up more
         # schedule_once counts from the loop's tick (clock.last_ts) unless that is 0.2 s old

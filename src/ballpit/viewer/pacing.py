@@ -6,12 +6,12 @@ window's thread and llvmpipe's, so 60 frames a second take about half a core. Dr
 gave the physics beside it about a quarter more steps while the pile lands (benchmarks/
 viewer_window_fps.py, docs/benchmarks.md). So the window draws at ``FAST_FPS`` while the physics
 thread has time to spare, steps down to ``SLOW_FPS`` (above the 30 FPS the viewer promises) while it
-is busy nearly all the time, that is behind real time or about to be, and goes back up once it has
-slack again. The two thresholds are apart so the rate does not flip every time the busy share is
-measured. A GPU draws a frame in a fraction of a millisecond of CPU; there the physics rarely needs
-the slower rate, and when it does (a scene too heavy for real time) nothing is lost by it.
+is busy nearly all the time, that is behind real time or about to be, unless it is so far behind that
+the CPU given back could not bring it near; and it goes back up once the physics has slack again.
+Each pair of thresholds is apart so the rate does not flip every time they are measured. A GPU draws
+a frame in a fraction of a millisecond of CPU; there the physics rarely needs the slower rate.
 
-No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share.
+No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share and pace.
 """
 
 from __future__ import annotations
@@ -22,19 +22,27 @@ FAST_FPS = 60.0  # frames a second while the physics has time to spare (a usual 
 SLOW_FPS = 33.0  # while it needs the CPU: just above the 30 FPS floor, with room for late frames
 BUSY_SLOW = 0.9  # the physics spent at least this share of its last measured stretch stepping: slow
 BUSY_FAST = 0.7  # at most this share: the full rate again
+# The share of the asked speed (real-time factor over time scale) the physics must reach for the slower
+# drawing to be worth it: the CPU it gives back buys about a quarter more steps, which brings a pile at
+# 0.6-0.8 of real time to it, but leaves a scene at a tenth of it (pile10k.toml landing) in slow motion
+# anyway, where the frames are worth more. Apart for the same reason as the busy thresholds.
+PACE_SLOW = 0.25
+PACE_FAST = 0.2
 
 
 @dataclass
 class FramePacer:
-    """Chooses the time between frames from the physics thread's busy share (0 to 1)."""
+    """Chooses the time between frames from the physics thread's busy share and pace."""
 
     slow: bool = False
 
-    def interval(self, busy: float) -> float:
-        """Seconds between frames, given the share of the latest stretch the physics spent stepping."""
-        if busy >= BUSY_SLOW:
+    def interval(self, busy: float, pace: float = 1.0) -> float:
+        """Seconds between frames, given the share of the latest stretch the physics spent stepping
+        (``busy``, 0 to 1) and the share of the asked speed it reached (``pace``: its real-time factor
+        over the time scale)."""
+        if busy >= BUSY_SLOW and pace >= PACE_SLOW:
             self.slow = True
-        elif busy <= BUSY_FAST:
+        elif busy <= BUSY_FAST or pace < PACE_FAST:
             self.slow = False
         return 1.0 / (SLOW_FPS if self.slow else FAST_FPS)
 

@@ -149,6 +149,12 @@ class PhysicsThread:
         sys.setswitchinterval(self._previous_switch)
 
     @property
+    def pace(self) -> float:
+        """The share of the asked speed the physics reached lately: real-time factor over time scale."""
+        sim = self.sim
+        return sim.real_time_factor / max(sim.time_scale, 1e-9)
+
+    @property
     def alive(self) -> bool:
         return self._thread.is_alive()
 
