@@ -83,11 +83,13 @@ def softness(hertz: float, zeta: float, h: float) -> Softness:
 class Frame:
     """What a soft frame leaves for the checks and the record: per contact the total normal impulse
     over the frame and the least separation seen; per ball touched (``balls``, world rows) the
-    largest move in one substep, and the box around the positions it passed."""
+    farthest it got from where it started and the largest move in one substep, and the box around
+    the positions it passed."""
 
     balls: np.ndarray
     impulse: np.ndarray
     least_separation: np.ndarray
+    farthest: np.ndarray
     largest_move: np.ndarray
     lo: np.ndarray  # (3, M) the lowest coordinates each ball had at a substep's end
     hi: np.ndarray
@@ -139,7 +141,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     push = np.empty((6, 2 * kc))
     total = np.zeros(kc)
     least = c.gap.copy()
-    largest = np.zeros(m)
+    farthest, largest = np.zeros(m), np.zeros(m)
     lo, hi = x[:, live].copy(), x[:, live].copy()
 
     for i in range(substeps):
@@ -170,6 +172,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # what the checks need: how far each ball got, and where
         moved = x[:, live] - before
         np.maximum(largest[live], _length(moved), out=largest[live])
+        np.maximum(farthest[live], _length(x[:, live] - x0[:, live]), out=farthest[live])
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
 
@@ -210,7 +213,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
-    return Frame(balls, total, least, largest, lo, hi)
+    return Frame(balls, total, least, farthest, largest, lo, hi)
 
 
 def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.ndarray, x0: np.ndarray,
