@@ -37,7 +37,7 @@ class Ends:
     each contact's a then b, ``share`` each ball's number of contacts (its mass is split that many
     ways), and ``add_up`` adds per-end values back per ball with one ``np.bincount``."""
 
-    def __init__(self, a: np.ndarray, b: np.ndarray, rows: int) -> None:
+    def __init__(self, a: np.ndarray, b: np.ndarray) -> None:
         self.k = len(a)
         ab = np.concatenate((a, b))
         rows_in_world = int(ab.max(initial=-1)) + 1
@@ -50,16 +50,14 @@ class Ends:
             self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
         self.share = np.bincount(self.ends, minlength=self.m).astype(float)
-        # where each of the (rows, 2K) per-end entries lands in the flattened (rows, M) per-ball array
-        self.scatter = (np.arange(rows)[:, None] * self.m + self.ends[None, :]).ravel()
 
     def add_up(self, values: np.ndarray) -> np.ndarray:
-        """(rows, 2K) values per contact end, summed per ball: (rows, M). Fewer rows than the ends were
-        built for sum into the first ones."""
-        rows = len(values)
-        scatter = self.scatter[: rows * 2 * self.k]
-        summed = np.bincount(scatter, weights=values.ravel(), minlength=rows * self.m)
-        return summed.reshape(rows, self.m)
+        """(rows, 2K) values per contact end, summed per ball: (rows, M), one ``np.bincount`` a row (as
+        fast as one over all rows, without a (rows, 2K) table of where each entry lands)."""
+        summed = np.empty((len(values), self.m))
+        for row, part in zip(summed, values, strict=True):
+            row[:] = np.bincount(self.ends, weights=part, minlength=self.m)
+        return summed
 
 
 class Contacts(Ends):
@@ -74,7 +72,7 @@ class Contacts(Ends):
     """
 
     def __init__(self, contacts: ContactRows) -> None:
-        super().__init__(contacts.a, contacts.b, 6)  # rows v and ω
+        super().__init__(contacts.a, contacts.b)
         k, m = self.k, self.m
         self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
         self.iia, self.iib = contacts.inv_inertia_a, contacts.inv_inertia_b
@@ -95,8 +93,12 @@ class Contacts(Ends):
         self.whole = inv_n
         self.inv_m_n, self.inv_m_t = float(inv_n.max()), float(inv_t.max())
         self.moving = contacts.moving
-        self.surface = np.ascontiguousarray(contacts.surface.T)
-        self.spin = np.ascontiguousarray(contacts.spin.T)
+        self.surface = np.ascontiguousarray(contacts.surface.T) if self.moving else None
+        self.spin = np.ascontiguousarray(contacts.spin.T) if self.moving else None
+        # scratch for what each contact adds to its a (columns :K) then its b (K:), and for the slip
+        # at the contact point and the relative spin (friction, rolling), kept for every sweep
+        self.push = np.empty((6, 2 * k))
+        self.motion = np.empty((2, 3, k))
         self.split()
 
     def split(self, pushing: np.ndarray | None = None) -> None:
@@ -154,15 +156,13 @@ def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarr
     the soft step); ``converge`` stops after a full sweep that changed no contact velocity by more
     than CONVERGED."""
     m_n = c.m_n if m_n is None else m_n
-    push = np.empty((6 if friction_every else 3, 2 * c.k))  # what each contact adds to its a, then its b
-    motion = np.empty((2, 3, c.k)) if friction_every else None  # slip at the contact point; relative spin
     for sweep in range(count):
         full = friction_every is not None and ((sweep + 1) % friction_every == 0 or sweep == count - 1)
         if not full:
-            normal = _normal_sweep(c, vw, push, normal, target, m_n, give)
+            normal = _normal_sweep(c, vw, c.push, normal, target, m_n, give)
             continue
-        normal, tangential, change = _full_sweep(c, vw, push, normal, tangential, target, motion, m_n, give,
-                                                 converge)  # fmt: skip
+        normal, tangential, change = _full_sweep(c, vw, c.push, normal, tangential, target, c.motion, m_n,
+                                                 give, converge)  # fmt: skip
         if converge and change < CONVERGED:
             break
     return normal, tangential
@@ -198,7 +198,7 @@ def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndar
                   m_n: np.ndarray, give: np.ndarray | float | None) -> np.ndarray:  # fmt: skip
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
-    vn = normal_speeds(c, vw, n, c.surface if c.moving else None)
+    vn = normal_speeds(c, vw, n, c.surface)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     lin = push[:3]
@@ -219,7 +219,7 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     k, n = c.k, c.n
     g = np.take(vw, c.ends, axis=1)
     va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
-    rel = model.contact_velocity(va, wa, vb, wb, n, c.ra, c.rb, c.surface if c.moving else None)
+    rel = model.contact_velocity(va, wa, vb, wb, n, c.ra, c.rb, c.surface)
     vn = model.dot(rel, n)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
@@ -227,7 +227,7 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
     np.subtract(wa, wb, out=motion[1])
-    if c.moving:
+    if c.spin is not None:
         motion[1] -= c.spin
     new_tr = model.within_limit(tangential - c.m_tr * motion, c.limits * new)
     d_tr = new_tr - tangential
@@ -243,7 +243,7 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
     proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world."""
-    e = Ends(a, b, 3)  # rows x, y, z
+    e = Ends(a, b)
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
     wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
     fa, fb = model.separation_parts(wa, wb)  # each end's part of the contact's correction

@@ -83,11 +83,13 @@ def softness(hertz: float, zeta: float, h: float) -> Softness:
 class Frame:
     """What a soft frame leaves for the checks and the record: per contact the total normal impulse
     over the frame and the least separation seen; per ball touched (``balls``, world rows) the
-    largest move in one substep, and the box around the positions it passed."""
+    farthest it got from where it started and the largest move in one substep, and the box around
+    the positions it passed."""
 
     balls: np.ndarray
     impulse: np.ndarray
     least_separation: np.ndarray
+    farthest: np.ndarray
     largest_move: np.ndarray
     lo: np.ndarray  # (3, M) the lowest coordinates each ball had at a substep's end
     hi: np.ndarray
@@ -123,7 +125,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     ends_a, ends_b = k.ends[:kc], k.ends[kc:]
     on_plane = rows.b == n_balls
     # the surface's own speed along the normal (moving planes), to move their side of s
-    surface_n = dot(k.surface, n) if k.moving else None
+    surface_n = dot(k.surface, n) if k.surface is not None else None
     hertz = min(CONTACT_HERTZ, 0.25 / h)
     ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
     bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
@@ -136,10 +138,9 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     apart = warm.apart_of(keys)
     normal = imp.normal.copy()
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-    push = np.empty((6, 2 * kc))
     total = np.zeros(kc)
     least = c.gap.copy()
-    largest = np.zeros(m)
+    farthest, largest = np.zeros(m), np.zeros(m)
     lo, hi = x[:, live].copy(), x[:, live].copy()
 
     for i in range(substeps):
@@ -148,7 +149,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         vw[:3, live] += lin * h
         vw[3:, live] += ang * h
         # 2. warm start
-        jacobi.apply(k, vw, push, normal, tangential)
+        jacobi.apply(k, vw, k.push, normal, tangential)
         # 3. solve with the soft bias
         s = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, i * h)
         # the contacts that can push this substep: pressed already, or closing faster than their gap
@@ -170,6 +171,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # what the checks need: how far each ball got, and where
         moved = x[:, live] - before
         np.maximum(largest[live], _length(moved), out=largest[live])
+        np.maximum(farthest[live], _length(x[:, live] - x0[:, live]), out=farthest[live])
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
 
@@ -192,8 +194,12 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     if (made < -penetration.OVERLAP_TOLERANCE).any():
         # those deeper than the slop go back to 0.8 of it, so they are not caught again next frame
         made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -0.8 * slop), made)
+        # only the contacts a move of up to twice the deepest deficit could reach take part: the others,
+        # farther apart than that, cannot be closed by moving these apart
+        part = np.flatnonzero(made < -2.0 * made.min())
         pos = with_static(body[:, X])
-        jacobi.separate(c.a, c.b, c.normal, made, rows.inv_mass_a, rows.inv_mass_b, pos, SEPARATE_SWEEPS)
+        jacobi.separate(c.a[part], c.b[part], c.normal[part], made[part], rows.inv_mass_a[part],
+                        rows.inv_mass_b[part], pos, SEPARATE_SWEEPS)  # fmt: skip
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
@@ -210,7 +216,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
-    return Frame(balls, total, least, largest, lo, hi)
+    return Frame(balls, total, least, farthest, largest, lo, hi)
 
 
 def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.ndarray, x0: np.ndarray,
@@ -294,7 +300,7 @@ def _accelerations(terms, constant, x: np.ndarray, vw: np.ndarray, q: np.ndarray
 def _normal_speed(k: jacobi.Contacts, vw: np.ndarray) -> np.ndarray:
     """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
     against a moving plane's surface."""
-    return jacobi.normal_speeds(k, vw, k.n, k.surface if k.moving else None)
+    return jacobi.normal_speeds(k, vw, k.n, k.surface)
 
 
 def _length(a: np.ndarray) -> np.ndarray:

@@ -94,7 +94,7 @@ def solve(
         return jacobi.solve(contacts, v, w, target, imp, jacobi_sweeps * iterations, friction_every)
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
-    ends = jacobi.Ends(contacts.a, contacts.b, 6)
+    ends = jacobi.Ends(contacts.a, contacts.b)
     vw = np.ascontiguousarray(np.hstack((v[ends.balls], w[ends.balls])).T)  # (6, M)
     colours = [_Colour(contacts, idx, ends.ends) for idx in contacts.colours]
     targets = [target[c.idx] for c in colours]

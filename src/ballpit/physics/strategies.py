@@ -201,14 +201,16 @@ def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPer
     step.integrate(hold, remaining)
 
 
-def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarray]) -> bool:
-    """A crowded step as one frame of ``model.substeps`` soft substeps (softstep.py) over every kept
-    pair ``c``; True when it was taken so.
+def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, np.ndarray]) -> bool:
+    """A crowded step as one frame of ``model.substeps`` soft substeps (softstep.py) over the kept
+    pairs ``contacts`` that could meet within it; True when it was taken so.
 
-    Every kept pair is solved, not just those closing now: within a frame a ball's neighbours change
-    speed (the ball under it stops on the floor, the one beside it bounces back), so a pair moving
-    together at the frame's start may meet at 5 m/s before its end. The kept pairs are every pair
-    whose paths' boxes meet; a speculative one pushes only if it closes faster than its gap allows.
+    A pair could meet within the frame if its gap is less than SPECULATIVE_REACH times the distance
+    its balls could cover towards each other at their own speeds, (|v_a| + |v_b| + (|a_a| + |a_b|)·dt)·dt
+    (with every plane), not at their relative speed: within a frame a ball's neighbours change speed
+    (the ball under it stops on the floor, the one beside it bounces back), so a pair falling together
+    meets at 5 m/s before the frame ends. Pairs at rest beside each other a fraction of a radius apart
+    are left out; a speculative pair pushes only if it closes faster than its gap allows.
 
     The soft step keeps the walls only while every ball it moves travels less than SUBSTEP_TRAVEL of
     its radius per substep, and while nothing it did not foresee happens. A frame is tried with twice
@@ -218,7 +220,7 @@ def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarr
     - a ball moved farther than that in a substep, or left the box its pairs were found from (then a
       pair the broad phase never saw could have met);
     - a solved contact overlapped deeper than DEEP_OVERLAP of the smaller radius at any substep's end;
-    - a pair the kept pairs did not hold (a ball left its box) overlaps that deep at the end.
+    - a pair left out of the contacts that could have met overlaps that deep at the end.
 
     When no try holds, the step is split at impacts instead (``split_at_impacts``, which passes
     through nothing, however fast).
@@ -230,6 +232,9 @@ def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarr
     acc = with_static(free)
     speed = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
     pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
+    reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
+    solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
+    c = contacts.subset(solved)
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
@@ -237,7 +242,7 @@ def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarr
             step.doubt = "a ball could travel farther than SUBSTEP_TRAVEL radii in a substep"
             continue
         last = substeps == model.substeps << RETRIES
-        frame = _soft_frame(step, c, substeps, last)
+        frame = _soft_frame(step, contacts, solved, c, substeps, last)
         if frame is not None:
             break
     else:
@@ -247,7 +252,8 @@ def crowded_step(step: Step, c: ContactPoints, accel: tuple[np.ndarray, np.ndarr
     return True
 
 
-def _soft_frame(step: Step, c: ContactPoints, substeps: int, last: bool) -> softstep.Frame | None:
+def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints, substeps: int,
+                last: bool) -> softstep.Frame | None:  # fmt: skip
     """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone,
     the reason in ``step.doubt``) when ``frame_doubt`` finds it cannot be trusted. The ``last`` try is
     kept when its only fault is a solved contact that overlapped deeper: that is no pass through
@@ -274,7 +280,7 @@ def _soft_frame(step: Step, c: ContactPoints, substeps: int, last: bool) -> soft
             state.body[others] = rows
     moving_planes.advance(model, state, dt)
     with step.profile.stage("time of impact"):
-        step.doubt = frame_doubt(step, c, frame, body_before)
+        step.doubt = frame_doubt(step, contacts, solved, c, frame, body_before)
     if step.doubt is None or (last and step.doubt == DEEPER):
         return frame
     state.body[:] = body_before  # undo it all
@@ -284,7 +290,8 @@ def _soft_frame(step: Step, c: ContactPoints, substeps: int, last: bool) -> soft
     return None
 
 
-def frame_doubt(step: Step, c: ContactPoints, frame: softstep.Frame, before: np.ndarray) -> str | None:
+def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: ContactPoints,
+                frame: softstep.Frame, before: np.ndarray) -> str | None:  # fmt: skip
     """Why a soft frame cannot be trusted (see ``crowded_step``), or None when it kept its promises.
 
     A ball that left the box its pairs were found from may have met a body the broad phase never
@@ -301,6 +308,11 @@ def frame_doubt(step: Step, c: ContactPoints, frame: softstep.Frame, before: np.
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
     if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
         return DEEPER
+    # how far each ball got from where it started (the others flew straight)
+    far = np.zeros(n + 1)
+    moved = state.body[:, X] - before[:, X]
+    far[:n] = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2 + moved[:, 2] ** 2)
+    far[balls] = np.maximum(far[balls], frame.farthest[cols])
     kept = step.pairs.kept
     lo, hi = frame.lo, frame.hi
     centre = kept.centre[balls].T
@@ -310,14 +322,18 @@ def frame_doubt(step: Step, c: ContactPoints, frame: softstep.Frame, before: np.
         or (hi + r > kept.hi[balls].T).any()
         or (np.sqrt(corner[0] ** 2 + corner[1] ** 2 + corner[2] ** 2) + r > kept.reach[balls]).any()
     )
-    if not escaped:  # every pair that could have met was solved
-        return None
-    # pairs around where the balls are now; those not solved are the ones left out
-    free, _ = free_acceleration(state.body, step.forces)
-    pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free)
-    now = narrowphase.contact_points(model, state, pairs)
-    out = now.subset(~np.isin(now.keys(), c.keys()))
-    out.gap = _gap_from(out, before, model, state)
+    if escaped:  # pairs around where the balls are now; those not solved are the ones left out
+        free, _ = free_acceleration(state.body, step.forces)
+        pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free)
+        now = narrowphase.contact_points(model, state, pairs)
+        out = now.subset(~np.isin(now.keys(), c.keys()))
+        out.gap = _gap_from(out, before, model, state)
+    else:
+        out = contacts.subset(~solved)
+        near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
+        out = out.subset(near)
+        start = np.minimum(out.gap, 0.0)
+        out.gap = _gap_from(out, before, model, state) - start
     if len(out) == 0:
         return None
     on_plane = out.kind == SPHERE_PLANE
