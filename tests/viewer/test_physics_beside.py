@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from ballpit.viewer.simulation import STATS_WINDOW
+
 from .conftest import run_driver, subprocess_env
 
 DRIVER = Path(__file__).with_name("window_driver.py")
@@ -24,9 +26,12 @@ def test_the_window_keeps_drawing_while_the_1200_ball_pile_lands(xvfb, tmp_path)
     # the physics takes 10-20 steps a second. The floor is far below that, for a loaded machine.
     assert r["steps_per_second"] > 0, r
     assert r["fps"] > 8.0, r
-    # honest: simulated over wall seconds (the HUD's over its last half second), not a slowed clock
+    # honest: simulated over wall seconds (the HUD's over its last half second), not a slowed clock.
+    # The fixed-step accumulator may carry up to one 1/60 s step into a window (CI read 1.01 once),
+    # so a pile that keeps up reads at most 1 + dt / STATS_WINDOW.
     factor = float(re.search(r"real-time factor (\d\.\d\d)", r["hud"]).group(1))
-    assert 0.0 < factor <= 1.0 and factor <= r["last_second_factor"] + 0.25, r
+    carried = (1.0 / 60.0) / STATS_WINDOW + 0.005  # and the HUD's rounding to two places
+    assert 0.0 < factor <= 1.0 + carried and factor <= r["last_second_factor"] + 0.25, r
 
 
 def test_esc_esc_closes_the_window_in_the_middle_of_a_10000_ball_step(xvfb, tmp_path):
