@@ -50,14 +50,19 @@ class Ends:
             self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
         self.share = np.bincount(self.ends, minlength=self.m).astype(float)
+        self._flat: dict[int, np.ndarray] = {}  # add_up's bins for every entry, by number of rows
 
     def add_up(self, values: np.ndarray) -> np.ndarray:
-        """(rows, 2K) values per contact end, summed per ball: (rows, M), one ``np.bincount`` a row (as
-        fast as one over all rows, without a (rows, 2K) table of where each entry lands)."""
-        summed = np.empty((len(values), self.m))
-        for row, part in zip(summed, values, strict=True):
-            row[:] = np.bincount(self.ends, weights=part, minlength=self.m)
-        return summed
+        """(rows, 2K) values per contact end, summed per ball: (rows, M), with one ``np.bincount`` over
+        all rows (row r's entries land in bins r·M + ball). bincount adds each bin's entries in their
+        order, so every sum is the same as one row at a time, at less than one call's cost a row."""
+        rows = len(values)
+        flat = self._flat.get(rows)
+        if flat is None:
+            flat = (self.ends[None, :] + self.m * np.arange(rows)[:, None]).ravel()
+            self._flat[rows] = flat
+        summed = np.bincount(flat, weights=values.ravel(), minlength=rows * self.m)
+        return summed.reshape(rows, self.m)
 
 
 class Contacts(Ends):
@@ -99,12 +104,16 @@ class Contacts(Ends):
         # at the contact point and the relative spin (friction, rolling), kept for every sweep
         self.push = np.empty((6, 2 * k))
         self.motion = np.empty((2, 3, k))
+        self._pushing: np.ndarray | None = None  # the mask of the last split (None: every contact)
         self.split()
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
         each): the effective masses ``m_n`` and ``m_tr`` (friction, then rolling, as (2, 1, K))."""
         k = self.k
+        if pushing is not None and self._pushing is not None and np.array_equal(pushing, self._pushing):
+            return  # the same contacts push as at the last split: the same shares and masses
+        self._pushing = None if pushing is None else pushing.copy()
         if pushing is None:
             share = self.share
         else:
