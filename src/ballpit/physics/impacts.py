@@ -238,14 +238,14 @@ def waves_from(rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: n
     return after, struck
 
 
-def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray,
-                 target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray, target: np.ndarray,
+                 start: np.ndarray | None = None, sweeps: int = WAVE_SWEEPS) -> tuple:  # fmt: skip
     """One wave of ``waves_from``: normal impulses alone on its contacts (``wave``: their columns a and
     b, normals, moving surfaces, inverse masses), each ball's mass split among the wave's contacts that
-    touch it (jacobi.py), driving v_n to ≥ ``target``, at most WAVE_SWEEPS sweeps and until none changes
-    a contact's speed by more than CONVERGED (a wave of contacts that share no ball takes one).
-    ``v`` ((3, M) columns; ``inv3`` their 1/m, three times over) changes in place. Returns the
-    impulses and the wave's normal speeds after them."""
+    touch it (jacobi.py), driving v_n to ≥ ``target`` from the accumulated ``start`` (zero: None), at
+    most ``sweeps`` sweeps and until none changes a contact's speed by more than CONVERGED (a wave of
+    contacts that share no ball takes one). ``v`` ((3, M) columns; ``inv3`` their 1/m, three times
+    over) changes in place. Returns the impulses and the wave's normal speeds after them."""
     ea, eb, n, surface, ima, imb = wave
     ends = np.concatenate((ea, eb))
     share = np.bincount(ends, minlength=m).astype(float)  # each ball's mass split among the wave
@@ -255,8 +255,8 @@ def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray,
     bound = float((ima + imb).max())  # 1/m_n unsplit: the most a unit impulse changes a contact's v_n
     # each contact end's row in one (3·M) bincount: x, y, z of column c at c, M + c, 2M + c
     rows3 = np.concatenate((ends, ends + m, ends + 2 * m))
-    impulse = np.zeros(len(ea))
-    for _ in range(WAVE_SWEEPS):
+    impulse = np.zeros(len(ea)) if start is None else start
+    for _ in range(sweeps):
         vn = contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
         new = contact_model.normal_impulse(impulse, m_n, target, vn)
         d = new - impulse
@@ -273,24 +273,34 @@ def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray,
     return impulse, contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
 
 
-def normal_solve(rows: ContactRows, v: np.ndarray, start: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Normal impulses alone (friction and rolling resistance left out) driving each contact of
-    ``rows`` to v_n ≥ ``target``, from the accumulated ``start`` (which may be taken back, never below
-    zero). Fewer than JACOBI_FROM contacts are solved colour by colour (``solver.solve``) to
-    convergence, at most WAVE_ITERATIONS sweeps: a struck chain's answer is then exact. More (a pile
-    landing) take RESTITUTION_SWEEPS Jacobi sweeps with mass splitting, as Box2D's restitution pass.
-    ``v`` ((3, M) velocities of the balls the contacts touch, in increasing order, the static row last
-    if there) changes in place; returns the accumulated impulses."""
-    if len(rows) >= JACOBI_FROM:
-        normal, _ = jacobi.sweeps(jacobi.Contacts(rows), v, start.copy(), None, target, RESTITUTION_SWEEPS)
+def normal_solve(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, idx: np.ndarray, start: np.ndarray,
+                 target: np.ndarray) -> np.ndarray:  # fmt: skip
+    """Normal impulses alone (friction and rolling resistance left out) driving the contacts ``idx`` of
+    a soft frame (``rows``, ``k``) to v_n ≥ ``target``, from the accumulated ``start`` (which may be
+    taken back, never below zero). Fewer than JACOBI_FROM contacts are solved colour by colour
+    (``solver.solve``) to convergence, at most WAVE_ITERATIONS sweeps: a struck chain's answer is then
+    exact. More (a pile landing) take RESTITUTION_SWEEPS Jacobi sweeps with mass splitting, as Box2D's
+    restitution pass. ``vw`` ((≥3, M) columns of ``k.balls``) changes in place; returns the
+    accumulated impulses."""
+    if len(idx) >= JACOBI_FROM:
+        kk = k.k
+        surface = k.surface[:, idx] if k.surface is not None else None
+        wave = (k.ends[:kk][idx], k.ends[kk:][idx], k.n[:, idx], surface, k.ima[idx], k.imb[idx])
+        v = np.array(vw[:3])
+        normal, _ = _wave_sweeps(
+            wave, k.m, np.tile(k.inverse[0], 3), v, target, start.copy(), RESTITUTION_SWEEPS
+        )
+        vw[:3] = v
         return normal
-    balls = np.unique(np.concatenate((rows.a, rows.b)))
-    none = np.zeros(len(rows))
-    smooth = dataclasses.replace(rows, friction=none, rolling=none)
-    full, spin = np.zeros((rows.static + 1, 3)), np.zeros((rows.static + 1, 3))
-    full[balls] = v[:3].T
-    imp = Impulses.zeros(len(rows))
+    sub = rows.subset(idx)
+    balls = np.unique(np.concatenate((sub.a, sub.b)))
+    cols = np.searchsorted(k.balls, balls)  # among the frame's columns
+    none = np.zeros(len(sub))
+    smooth = dataclasses.replace(sub, friction=none, rolling=none)
+    full, spin = np.zeros((sub.static + 1, 3)), np.zeros((sub.static + 1, 3))
+    full[balls] = vw[:3, cols].T
+    imp = Impulses.zeros(len(sub))
     imp.normal[:] = start
     imp = solver.solve(smooth, full, spin, target, imp, WAVE_ITERATIONS)
-    v[:3] = full[balls].T
+    vw[:3, cols] = full[balls].T
     return imp.normal

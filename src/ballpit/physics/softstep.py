@@ -279,12 +279,8 @@ def restitution_pass(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, norm
         touched[-1] = False
     near = struck | (pressed & (touched[k.ends[: k.k]] | touched[k.ends[k.k :]]))
     bouncing = np.flatnonzero(near)
-    sub = rows.subset(bouncing)
-    cols = np.searchsorted(k.balls, np.unique(np.concatenate((sub.a, sub.b))))  # among the frame's columns
-    v = vw[:3, cols]
     start = normal[bouncing]
-    acc = impacts.normal_solve(sub, v, start, np.maximum(after[bouncing], 0.0))
-    vw[:3, cols] = v
+    acc = impacts.normal_solve(rows, k, vw, bouncing, start, np.maximum(after[bouncing], 0.0))
     added[bouncing] = acc - start
     return added
 
