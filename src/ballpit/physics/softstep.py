@@ -49,7 +49,7 @@ from .rows import ContactRows, contact_rows
 from .settings import (
     CONTACT_HERTZ,
     DAMPING_RATIO,
-    IMPACT_WARM_GROWTH,
+    LEVEL,
     MAX_PUSH,
     RELAX_SWEEPS,
     SEPARATE_SWEEPS,
@@ -177,13 +177,14 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
 
     added = restitution_pass(rows, k, vw, normal, vn_start, threshold, total > 0.0)
     total += added
-    # a contact the impacts changed is warm-started next frame with at most what it was this frame plus
-    # IMPACT_WARM_GROWTH times its share of the weight along its normal over a substep, m_n·|g·n|·h: its
-    # last substep's impulse holds the impact's too (a struck chain's compression), which warm-started
-    # again would push apart the balls the waves left still (#24)
+    # a level contact (normal within LEVEL of square to gravity: it holds up no weight) that the impacts
+    # changed keeps no more warm start than it came with: its last substep's impulse was the impact's
+    # compression, which warm-started again would push apart the balls the waves left still (#24)
     g = model.gravity
-    weight = IMPACT_WARM_GROWTH * np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) * h / k.whole
-    kept = np.where(added != 0.0, np.minimum(normal, imp.normal + weight), normal)
+    level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
+        float(dot(g[:, None], g[:, None])[0])
+    )
+    kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
     warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
     body[idx, X] = x[:, live].T
     body[idx, V] = vw[:3, live].T
