@@ -33,11 +33,12 @@ At the bound: what still closes after MAX_WAVES waves is stopped, e = 0, by ``st
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
-from . import contact_model, solver
+from . import contact_model, exact, jacobi, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
@@ -46,9 +47,12 @@ from .settings import (
     APPROACH_SPEED,
     BOUNCE_HOPS,
     BOUNCE_JACOBI_SWEEPS,
+    CONVERGED,
     JACOBI_FROM,
     MAX_WAVES,
+    RESTITUTION_SWEEPS,
     WAVE_ITERATIONS,
+    WAVE_SWEEPS,
 )
 from .state import State, V, W, with_static
 
@@ -174,3 +178,129 @@ def _keep_energy(model: Model, rows: ContactRows, before: tuple[np.ndarray, ...]
     v[balls] = v0 + s * dv
     w[balls] = w0 + s * dw
     return s
+
+
+def waves_from(rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: np.ndarray,
+               restitution_threshold: float, pressed: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
+    """The module's rule for a frame solved as a whole (the soft step's restitution, softstep.py): the
+    waves are run on the normal speeds the contacts had at the frame's start, ``vn_start``, over the
+    contacts that pushed during it (``pressed``), and give what each contact's normal speed should be
+    after the impact. Returns those speeds and which contacts took part in a wave.
+
+    The frame's velocities ``v`` ((≥3, M) columns of ``k.balls``) are not changed: the waves run on a
+    copy, measured as v_n(start) + (v_n(copy) − v_n(end)). A wave's impulses change the speeds the same
+    way whatever velocities they start from, so this is the rule applied to the frame's start, without
+    its start velocities: its arriving contacts (closing faster than the threshold) are solved together
+    to v_n' ≥ −e·v_n, then those the wave set closing, at most MAX_WAVES times; no wave adds energy
+    (ΔK = Σ P·(v_n + ½·Δv_n) ≤ 0, checked and scaled as ``_keep_energy`` does).
+    """
+    copy = np.array(v[:3])
+    after = np.array(vn_start)
+    struck = np.zeros(k.k, bool)
+    # the contacts that can take part, with what the waves need of them
+    cand = np.flatnonzero(pressed & (k.ima + k.imb > 0.0))
+    kk, m = k.k, k.m
+    ea, eb = k.ends[:kk][cand], k.ends[kk:][cand]
+    n = k.n[:, cand]
+    surface = k.surface[:, cand] if k.surface is not None else None
+    ima, imb, e = k.ima[cand], k.imb[cand], rows.restitution[cand]
+
+    def speeds(v: np.ndarray, at: np.ndarray | slice = slice(None)) -> np.ndarray:
+        s = None if surface is None else surface[:, at]
+        return contact_model.normal_speed(np.take(v, ea[at], axis=1), np.take(v, eb[at], axis=1), n[:, at], s)
+
+    offset = vn_start[cand] - speeds(copy)
+    vn = vn_start[cand]
+    inv3 = np.tile(k.inverse[0], 3)  # each column's own 1/m, for x, y and z
+    closing = -max(restitution_threshold, APPROACH_SPEED)
+    for _ in range(MAX_WAVES):
+        idx = np.flatnonzero(vn < closing)  # the contacts arriving now
+        if idx.size == 0:
+            break
+        struck[cand[idx]] = True
+        before = copy.copy()
+        target = -e[idx] * vn[idx] - offset[idx]  # v_n' ≥ −e·v_n, as the copy measures it
+        wave = (ea[idx], eb[idx], n[:, idx], None if surface is None else surface[:, idx], ima[idx], imb[idx])
+        impulse, after_vn = _wave_sweeps(wave, m, inv3, copy, target)
+        after_vn += offset[idx]
+        # ΔK of the wave's normal impulses: Σ P·v_n + ½·Σ P·Δv_n (spheres: they do not turn the balls)
+        gain_b = exact.total(impulse * vn[idx])
+        gain_a = exact.total(impulse * (after_vn - vn[idx]))
+        if not rows.moving and gain_b + 0.5 * gain_a > 0.0 and gain_a > 0.0:
+            copy = before + max(0.0, -2.0 * gain_b / gain_a) * (copy - before)
+        # only the contacts of the balls the wave moved change speed
+        moved = np.zeros(m, bool)
+        moved[wave[0]] = True
+        moved[wave[1]] = True
+        near = np.flatnonzero(moved[ea] | moved[eb])
+        vn[near] = speeds(copy, near) + offset[near]
+    after[cand] = vn
+    return after, struck
+
+
+def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray, target: np.ndarray,
+                 start: np.ndarray | None = None, sweeps: int = WAVE_SWEEPS) -> tuple:  # fmt: skip
+    """One wave of ``waves_from``: normal impulses alone on its contacts (``wave``: their columns a and
+    b, normals, moving surfaces, inverse masses), each ball's mass split among the wave's contacts that
+    touch it (jacobi.py), driving v_n to ≥ ``target`` from the accumulated ``start`` (zero: None), at
+    most ``sweeps`` sweeps and until none changes a contact's speed by more than CONVERGED (a wave of
+    contacts that share no ball takes one). ``v`` ((3, M) columns; ``inv3`` their 1/m, three times
+    over) changes in place. Returns the impulses and the wave's normal speeds after them."""
+    ea, eb, n, surface, ima, imb = wave
+    ends = np.concatenate((ea, eb))
+    share = np.bincount(ends, minlength=m).astype(float)  # each ball's mass split among the wave
+    m_n = (
+        1.0 / contact_model.inverse_effective_masses(share[ea] * ima, share[eb] * imb, 0.0, 0.0, 0.0, 0.0)[0]
+    )
+    bound = float((ima + imb).max())  # 1/m_n unsplit: the most a unit impulse changes a contact's v_n
+    # each contact end's row in one (3·M) bincount: x, y, z of column c at c, M + c, 2M + c
+    rows3 = np.concatenate((ends, ends + m, ends + 2 * m))
+    impulse = np.zeros(len(ea)) if start is None else start
+    for _ in range(sweeps):
+        vn = contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
+        new = contact_model.normal_impulse(impulse, m_n, target, vn)
+        d = new - impulse
+        impulse = new
+        change = float(np.abs(d).max()) * bound
+        if change == 0.0:
+            return impulse, vn
+        push = d * n
+        v += (
+            np.bincount(rows3, np.concatenate((push, -push), axis=1).ravel(), minlength=3 * m) * inv3
+        ).reshape(3, m)
+        if change < CONVERGED:
+            break
+    return impulse, contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
+
+
+def normal_solve(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, idx: np.ndarray, start: np.ndarray,
+                 target: np.ndarray) -> np.ndarray:  # fmt: skip
+    """Normal impulses alone (friction and rolling resistance left out) driving the contacts ``idx`` of
+    a soft frame (``rows``, ``k``) to v_n ≥ ``target``, from the accumulated ``start`` (which may be
+    taken back, never below zero). Fewer than JACOBI_FROM contacts are solved colour by colour
+    (``solver.solve``) to convergence, at most WAVE_ITERATIONS sweeps: a struck chain's answer is then
+    exact. More (a pile landing) take RESTITUTION_SWEEPS Jacobi sweeps with mass splitting, as Box2D's
+    restitution pass. ``vw`` ((≥3, M) columns of ``k.balls``) changes in place; returns the
+    accumulated impulses."""
+    if len(idx) >= JACOBI_FROM:
+        kk = k.k
+        surface = k.surface[:, idx] if k.surface is not None else None
+        wave = (k.ends[:kk][idx], k.ends[kk:][idx], k.n[:, idx], surface, k.ima[idx], k.imb[idx])
+        v = np.array(vw[:3])
+        normal, _ = _wave_sweeps(
+            wave, k.m, np.tile(k.inverse[0], 3), v, target, start.copy(), RESTITUTION_SWEEPS
+        )
+        vw[:3] = v
+        return normal
+    sub = rows.subset(idx)
+    balls = np.unique(np.concatenate((sub.a, sub.b)))
+    cols = np.searchsorted(k.balls, balls)  # among the frame's columns
+    none = np.zeros(len(sub))
+    smooth = dataclasses.replace(sub, friction=none, rolling=none)
+    full, spin = np.zeros((sub.static + 1, 3)), np.zeros((sub.static + 1, 3))
+    full[balls] = vw[:3, cols].T
+    imp = Impulses.zeros(len(sub))
+    imp.normal[:] = start
+    imp = solver.solve(smooth, full, spin, target, imp, WAVE_ITERATIONS)
+    vw[:3, cols] = full[balls].T
+    return imp.normal

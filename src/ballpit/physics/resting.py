@@ -30,6 +30,8 @@ class WarmStart:
         self.forces = Impulses.zeros(0)
         # per kept pair, how far a soft step's spring holds it apart beyond its overlap (softstep.py)
         self.apart = np.zeros(0)
+        # the same three for the pairs of sleeping balls, put aside when they fell asleep (``put_to_sleep``)
+        self.asleep = (np.zeros(0, np.int64), Impulses.zeros(0), np.zeros(0))
 
     def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""
@@ -55,6 +57,50 @@ class WarmStart:
         self.forces = Impulses(*(part[order] / h for part in parts))
         self.apart = np.zeros(len(keys))
 
+    def put_to_sleep(self, asleep: np.ndarray) -> None:
+        """Put aside the kept forces of the pairs whose balls are all ``asleep`` (a plane counts as
+        asleep): sleeping pairs are not solved, so the next ``keep`` would forget them, and a pile woken
+        with no warm start sags under its own weight and springs back up, gaining energy (#24)."""
+        held = _asleep_pairs(self.keys, asleep)
+        if not held.any():
+            return
+        keys, forces, apart = self.asleep
+        self.asleep = _sorted(
+            np.concatenate((keys, self.keys[held])),
+            Impulses(
+                *(
+                    np.concatenate((old, new[held]))
+                    for old, new in zip(_parts(forces), _parts(self.forces), strict=True)
+                )
+            ),
+            np.concatenate((apart, self.apart[held])),
+        )
+
+    def wake(self, asleep: np.ndarray) -> None:
+        """Bring back the forces put aside of the pairs that are no longer all ``asleep``, for the next
+        solve to start from."""
+        keys, forces, apart = self.asleep
+        if len(keys) == 0:
+            return
+        still = _asleep_pairs(keys, asleep)
+        if still.all():
+            return
+        woken = ~still
+        fresh = ~np.isin(keys[woken], self.keys)  # a pair solved since keeps what it was solved to
+        back = np.flatnonzero(woken)[fresh]
+        merged = _sorted(
+            np.concatenate((self.keys, keys[back])),
+            Impulses(
+                *(
+                    np.concatenate((new, old[back]))
+                    for new, old in zip(_parts(self.forces), _parts(forces), strict=True)
+                )
+            ),
+            np.concatenate((self.apart, apart[back])),
+        )
+        self.keys, self.forces, self.apart = merged
+        self.asleep = (keys[still], Impulses(*(part[still] for part in _parts(forces))), apart[still])
+
     def apart_of(self, keys: np.ndarray) -> np.ndarray:
         """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept)."""
         held = np.zeros(len(keys))
@@ -68,6 +114,26 @@ class WarmStart:
     def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
         """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
         self.apart = apart[np.argsort(keys)]
+
+
+def _asleep_pairs(keys: np.ndarray, asleep: np.ndarray) -> np.ndarray:
+    """Which pairs ``keys`` (``contacts.pair_keys``) have every ball ``asleep``; a plane always."""
+    a = (keys >> np.int64(32)).astype(np.intp)
+    low = keys & np.int64(0xFFFFFFFF)
+    plane = (low & np.int64(1 << 31)) != 0
+    other = np.where(plane, 0, low).astype(np.intp)
+    n = len(asleep)
+    ok = (a < n) & (other < n)  # pairs of balls no longer in the world are dropped
+    return ok & asleep[np.minimum(a, n - 1)] & (plane | asleep[np.minimum(other, n - 1)])
+
+
+def _sorted(keys: np.ndarray, forces: Impulses, apart: np.ndarray) -> tuple[np.ndarray, Impulses, np.ndarray]:
+    order = np.argsort(keys, kind="stable")
+    return keys[order], Impulses(*(part[order] for part in _parts(forces))), apart[order]
+
+
+def _parts(imp: Impulses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return imp.normal, imp.friction, imp.rolling
 
 
 def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,

@@ -8,7 +8,9 @@ settled pile is the state most scenes spend most of their time in. The rules, as
 - Balls touching each other form an island; an island falls asleep whole, and only when every ball in
   it has been still for TIME_TO_SLEEP. Asleep, a ball's velocity and spin are exactly zero and a step
   leaves it where it is: its pairs with other sleeping balls and with planes are not measured or
-  solved, and a holding force cancels its free acceleration, so it neither falls nor drifts.
+  solved, and a holding force cancels its free acceleration, so it neither falls nor drifts. The
+  warm start of its pairs is put aside while it sleeps and given back when it wakes
+  (``resting.WarmStart.put_to_sleep`` and ``wake``), so a woken pile holds where it was.
 - An island wakes whole when an awake ball touches one of its balls or could reach one within the
   step (the same bound the crowd test uses), when a step leaves one of its balls moving, or when one
   of its balls is moved or set moving by hand. Changing gravity or the radii, moving any plane, or

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import jacobi, penetration, quaternion
+from . import impacts, jacobi, penetration, quaternion
 from .contact_model import Impulses, dot
 from .contacts import ContactPoints
 from .forces import ConstantPerBall, ForceTerm, constant_acceleration
@@ -49,9 +49,9 @@ from .rows import ContactRows, contact_rows
 from .settings import (
     CONTACT_HERTZ,
     DAMPING_RATIO,
+    LEVEL,
     MAX_PUSH,
     RELAX_SWEEPS,
-    RESTITUTION_SWEEPS,
     SEPARATE_SWEEPS,
     SLOP,
     SOLVE_SWEEPS,
@@ -175,8 +175,17 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
 
-    warm.keep(keys, Impulses(normal, tangential[0].T.copy(), tangential[1].T.copy()), h)
-    total += restitution_pass(rows, k, vw, normal, vn_start, threshold, total > 0.0)
+    added = restitution_pass(rows, k, vw, normal, vn_start, threshold, total > 0.0)
+    total += added
+    # a level contact (normal within LEVEL of square to gravity: it holds up no weight) that the impacts
+    # changed keeps no more warm start than it came with: its last substep's impulse was the impact's
+    # compression, which warm-started again would push apart the balls the waves left still (#24)
+    g = model.gravity
+    level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
+        float(dot(g[:, None], g[:, None])[0])
+    )
+    kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
+    warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
     body[idx, X] = x[:, live].T
     body[idx, V] = vw[:3, live].T
     body[idx, W] = vw[3:, live].T
@@ -250,25 +259,29 @@ def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.
 
 def restitution_pass(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray,
                      vn_start: np.ndarray, threshold: float, pressed: np.ndarray) -> np.ndarray:  # fmt: skip
-    """Box2D's restitution: each contact that closed faster than ``threshold`` when the frame began
-    (``vn_start``) and pushed during it (``pressed``) is driven to leave at e times that speed,
-    v_n ≥ −e·v_n₀, starting from the last substep's normal impulse ``normal`` (which the pass may take
-    back, never below zero). Normal impulses only, all bouncing contacts at once (Jacobi with mass
-    splitting over them). ``vw`` changes in place; returns the impulse added per contact.
-
-    This is the simultaneous-impact rule of the crowded step; another rule (impacts in waves) can
-    replace this function without touching the substeps."""
+    """The frame's impacts, by the rule of the split step (impacts in waves, ``impacts.waves_from``):
+    when a contact that pushed during the frame (``pressed``) closed faster than ``threshold`` at its
+    start (``vn_start``), the waves are run from those starting normal speeds over the pressed
+    contacts, and the contacts they struck, with the pressed ones beside them, are driven to the normal
+    speeds the waves left, v_n ≥ max(v_n,waves, 0). So a contact alone in its wave leaves at −e·v_n₀
+    (Box2D's restitution), and a touching chain struck inside a pile passes the impulse ball by ball.
+    The solve starts from the last substep's normal impulse ``normal`` (which it may take back, never
+    below zero); normal impulses only, to convergence (``impacts.normal_solve``). ``vw`` changes in
+    place; returns the impulse added per contact."""
     added = np.zeros(len(normal))
-    bouncing = np.flatnonzero(pressed & (vn_start < -threshold) & (rows.restitution > 0.0))
-    if bouncing.size == 0:
+    if not (pressed & (vn_start < -threshold) & (rows.restitution > 0.0)).any():
         return added
-    sub = jacobi.Contacts(rows.subset(bouncing))
-    cols = np.searchsorted(k.balls, sub.balls)  # the bouncing balls among the frame's columns
-    v = vw[:3, cols]
-    target = -rows.restitution[bouncing] * vn_start[bouncing]
+    after, struck = impacts.waves_from(rows, k, vw, vn_start, threshold, pressed)
+    # the pressed contacts beside a struck one take part too: a ball the waves left still holds on them
+    touched = np.zeros(k.m, bool)
+    touched[k.ends[: k.k][struck]] = True
+    touched[k.ends[k.k :][struck]] = True
+    if k.balls[-1] == rows.static:
+        touched[-1] = False
+    near = struck | (pressed & (touched[k.ends[: k.k]] | touched[k.ends[k.k :]]))
+    bouncing = np.flatnonzero(near)
     start = normal[bouncing]
-    acc, _ = jacobi.sweeps(sub, v, start.copy(), None, target, RESTITUTION_SWEEPS)
-    vw[:3, cols] = v
+    acc = impacts.normal_solve(rows, k, vw, bouncing, start, np.maximum(after[bouncing], 0.0))
     added[bouncing] = acc - start
     return added
 

@@ -335,6 +335,9 @@ class World:
                     contacts = narrowphase.contact_points(model, state, pairs)
                 with prof.stage("sleep"):
                     reach = strategies.speculative_reach(step, contacts, unheld)
+        if model.sleep and len(self._warm.asleep[0]):
+            with prof.stage("sleep"):
+                self._warm.wake(sleep.asleep)  # the pairs of woken islands start from what they held
         with prof.stage("crowd test"):
             crowd = strategies.crowded(step, contacts, free)
         if crowd and strategies.crowded_step(step, contacts, (free, ang)):
@@ -343,7 +346,10 @@ class World:
             strategies.split_at_impacts(step, contacts, pairs, (free, ang))
         if model.sleep:
             with prof.stage("sleep"):
+                was = sleep.asleep.copy() if sleep.any or sleeping.may_fall_asleep(sleep, dt) else None
                 sleeping.after_step(model, state, sleep, contacts, reach, dt)
+                if was is not None and (sleep.asleep & ~was).any():
+                    self._warm.put_to_sleep(sleep.asleep)
         validation.undo_non_finite_step(state.body, before)
         if model.moving_planes():  # else the step left them as they were checked
             self._remember_planes()
