@@ -104,16 +104,12 @@ class Contacts(Ends):
         # at the contact point and the relative spin (friction, rolling), kept for every sweep
         self.push = np.empty((6, 2 * k))
         self.motion = np.empty((2, 3, k))
-        self._pushing: np.ndarray | None = None  # the mask of the last split (None: every contact)
         self.split()
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
         each): the effective masses ``m_n`` and ``m_tr`` (friction, then rolling, as (2, 1, K))."""
         k = self.k
-        if pushing is not None and self._pushing is not None and np.array_equal(pushing, self._pushing):
-            return  # the same contacts push as at the last split: the same shares and masses
-        self._pushing = None if pushing is None else pushing.copy()
         if pushing is None:
             share = self.share
         else:
