@@ -64,22 +64,12 @@ class WarmStart:
         held = _asleep_pairs(self.keys, asleep)
         if not held.any():
             return
-        keys, forces, apart = self.asleep
-        self.asleep = _sorted(
-            np.concatenate((keys, self.keys[held])),
-            Impulses(
-                *(
-                    np.concatenate((old, new[held]))
-                    for old, new in zip(_parts(forces), _parts(self.forces), strict=True)
-                )
-            ),
-            np.concatenate((apart, self.apart[held])),
-        )
+        self.asleep = _merged(self.asleep, _rows((self.keys, self.forces, self.apart), held))
 
     def wake(self, asleep: np.ndarray) -> None:
         """Bring back the forces put aside of the pairs that are no longer all ``asleep``, for the next
         solve to start from."""
-        keys, forces, apart = self.asleep
+        keys = self.asleep[0]
         if len(keys) == 0:
             return
         still = _asleep_pairs(keys, asleep)
@@ -88,18 +78,9 @@ class WarmStart:
         woken = ~still
         fresh = ~np.isin(keys[woken], self.keys)  # a pair solved since keeps what it was solved to
         back = np.flatnonzero(woken)[fresh]
-        merged = _sorted(
-            np.concatenate((self.keys, keys[back])),
-            Impulses(
-                *(
-                    np.concatenate((new, old[back]))
-                    for new, old in zip(_parts(self.forces), _parts(forces), strict=True)
-                )
-            ),
-            np.concatenate((self.apart, apart[back])),
-        )
+        merged = _merged((self.keys, self.forces, self.apart), _rows(self.asleep, back))
         self.keys, self.forces, self.apart = merged
-        self.asleep = (keys[still], Impulses(*(part[still] for part in _parts(forces))), apart[still])
+        self.asleep = _rows(self.asleep, still)
 
     def apart_of(self, keys: np.ndarray) -> np.ndarray:
         """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept)."""
@@ -127,9 +108,23 @@ def _asleep_pairs(keys: np.ndarray, asleep: np.ndarray) -> np.ndarray:
     return ok & asleep[np.minimum(a, n - 1)] & (plane | asleep[np.minimum(other, n - 1)])
 
 
-def _sorted(keys: np.ndarray, forces: Impulses, apart: np.ndarray) -> tuple[np.ndarray, Impulses, np.ndarray]:
-    order = np.argsort(keys, kind="stable")
-    return keys[order], Impulses(*(part[order] for part in _parts(forces))), apart[order]
+Kept = tuple[np.ndarray, Impulses, np.ndarray]  # pair keys, their forces and how far they are held apart
+
+
+def _rows(kept: Kept, idx: np.ndarray) -> Kept:
+    """The pairs ``idx`` (indices or a mask) of ``kept``."""
+    keys, forces, apart = kept
+    return keys[idx], Impulses(*(part[idx] for part in _parts(forces))), apart[idx]
+
+
+def _merged(first: Kept, second: Kept) -> Kept:
+    """Both sets of pairs, ``first``'s then ``second``'s, sorted by key (stably)."""
+    keys = np.concatenate((first[0], second[0]))
+    forces = Impulses(
+        *(np.concatenate(pair) for pair in zip(_parts(first[1]), _parts(second[1]), strict=True))
+    )
+    apart = np.concatenate((first[2], second[2]))
+    return _rows((keys, forces, apart), np.argsort(keys, kind="stable"))
 
 
 def _parts(imp: Impulses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

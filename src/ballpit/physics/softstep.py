@@ -182,7 +182,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # compression, which warm-started again would push apart the balls the waves left still (#24)
     g = model.gravity
     level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
-        float(dot(g[:, None], g[:, None])[0])
+        g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
     )
     kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
     warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
