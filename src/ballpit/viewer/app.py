@@ -609,4 +609,22 @@ def run(
         viewer.run()
     finally:
         viewer.finish_record()
+    if viewer.physics.alive:
+        _end_mid_step()
     return 0
+
+
+def _end_mid_step() -> None:
+    """End the process now, the window closed and its record written, while the physics thread is still
+    inside a step. Python 3.11 ends a daemon thread that wants the GIL back after finalisation began with
+    ``pthread_exit``, and the forced unwind aborts the process ("terminate called without an active
+    exception", SIGABRT) when it passes a C++ frame of NumPy's that released the GIL (``np.unique``'s
+    hashing does: 2 aborts in 20 exits in a probe). Nothing is left to write, so skip the finalisation."""
+    import os
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(0)
