@@ -615,6 +615,10 @@ def main(scenarios: dict | None = None) -> None:
             viewer.close()
             viewer.pump()  # outside pyglet's loop the window closes on the next pump
         print(line, flush=True)
+    # a physics thread may still be inside a step (escape_mid_step): end as the viewer's run() does
+    from ballpit.viewer.app import _end_mid_step
+
+    _end_mid_step()
 
 
 if __name__ == "__main__":
