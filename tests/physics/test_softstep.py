@@ -153,7 +153,10 @@ def test_columns_eight_balls_tall_stand_still_without_sinking_into_each_other():
     # seven balls' weight. A soft contact rests at the overlap its load needs, F·(1/m_a + 1/m_b)/ω²
     # (2 % of a radius here at 60 Hz), deeper than the slop the soft step moves apart by positions;
     # moved apart, the spring must keep holding the load, or the columns sink back and are moved apart
-    # again every step (they jittered at 7 mm/s); a stiffer spring rang instead.
+    # again every step (they jittered at 7 mm/s); a stiffer spring rang instead. Their 1 mm gaps close
+    # at up to 0.45 m/s, which presses the columns 4 % of a radius into each other; the springs may not
+    # lift them back out with energy the world does not have (they once gained 10 J doing it, #24), so
+    # they stand at that overlap, never deeper, and no step adds energy.
     world = ballpit.World()
     world.add_plane(normal=(0, 1, 0), friction=0.5, rolling_friction=0.05, restitution=0.3)
     for normal in ((1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)):
@@ -162,17 +165,20 @@ def test_columns_eight_balls_tall_stand_still_without_sinking_into_each_other():
     ix, iy, iz = (a.ravel() for a in np.meshgrid(np.arange(6), np.arange(8), np.arange(6), indexing="ij"))
     world.add_spheres(np.column_stack(((ix - 2.5) * 0.1, 0.051 + iy * 0.101, (iz - 2.5) * 0.1)), radius=r,
                       restitution=0.5, rolling_friction=0.05)  # fmt: skip
-    for _ in range(480):
-        world.step(1 / 240)
+    energy = world.kinetic_energy() + world.potential_energy()
     fastest = 0.0
-    for _ in range(120):
+    for i in range(600):
         world.step(1 / 240)
-        fastest = max(fastest, float(np.linalg.norm(world.spheres.velocities, axis=1).max()))
+        now = world.kinetic_energy() + world.potential_energy()
+        assert now <= energy + 1e-12 * abs(now), (i, now - energy)
+        energy = now
+        if i >= 480:
+            fastest = max(fastest, float(np.linalg.norm(world.spheres.velocities, axis=1).max()))
     assert world.crowded_steps == 600  # every step a soft frame
     assert fastest < 1e-3
     x = world.spheres.positions
     d = np.linalg.norm(x[:, None] - x[None], axis=2) + np.eye(len(x)) * 1e9
-    assert (2 * r - d).max() < 0.02 * r
+    assert (2 * r - d).max() < 0.05 * r
     assert x[:, 1].min() > r - 0.02 * r
 
 

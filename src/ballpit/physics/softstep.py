@@ -357,7 +357,14 @@ def hold_energy(model, state, before: np.ndarray, balls: np.ndarray) -> None:
     work, a frame may lose energy (inelastic bounces, friction) but never gain it, yet pushing overlaps
     apart lifts balls and a Jacobi restitution pass can overshoot. Their velocities relative to their
     centre of mass (and their spins) are scaled by the one factor that gives back the energy they had
-    at ``before``, E = ½·m·v² + ½·I·ω² − m·g·x: momentum is kept, and so is every direction of motion."""
+    at ``before``, E = ½·m·v² + ½·I·ω² − m·g·x: momentum is kept, and so is every direction of motion.
+
+    When the springs lifted the balls by more than all their motion relative to the centre of mass
+    can pay (a settled pile whose load shifted: the overlaps it sank into spring back), that motion
+    is stopped and the balls that rose are taken back towards where they started, each by the one
+    fraction λ of its rise that leaves the energy they had (the potential −m·g·x is linear in x, so
+    λ is exact); the balls that sank keep their places. The overlaps left are those of the frame's
+    start or less, and the next frames push them apart as far as energy allows."""
     sleeping = state.sleep.asleep
     if len(sleeping) == len(state.body) and sleeping.any():
         balls = balls[~sleeping[balls]]
@@ -388,3 +395,12 @@ def hold_energy(model, state, before: np.ndarray, balls: np.ndarray) -> None:
     scale = math.sqrt(room / k_rel) if room > 0.0 and k_rel > 0.0 else 0.0
     state.body[balls, V] = v_cm + scale * (v - v_cm)
     state.body[balls, W] = scale * w
+    if room < 0.0:  # the rise is more than the motion can pay: take the rising balls part way back
+        x0, x1 = old[:, X], new[:, X]
+        rise = -mass * (
+            (x1[:, 0] - x0[:, 0]) * g[0] + (x1[:, 1] - x0[:, 1]) * g[1] + (x1[:, 2] - x0[:, 2]) * g[2]
+        )
+        up = rise > 0.0
+        lifted = float(np.cumsum(np.where(up, rise, 0.0))[-1])
+        fraction = min(max(1.0 + room / lifted, 0.0), 1.0) if lifted > 0.0 else 1.0
+        state.body[balls[up], 0:3] = x0[up] + fraction * (x1[up] - x0[up])
