@@ -10,7 +10,8 @@ Per scene, medians over the runs of:
 - ``fps_before_x``: the title's frame rate while the scene waits for X (``--seconds`` long);
 - the landing, from X until the simulated clock reaches ``--land`` seconds (pile.toml lands in its
   first 2 s): ``land_fps`` frames per wall second, ``land_rtf`` simulated over wall seconds (1.00 is
-  real time; the clock cannot run ahead of real time), ``hud_rtf`` and ``hud_rtf_min`` the median and
+  real time; the time is that of the state the window shows, not of the World, which may be stepped
+  up to ``stepper.LEAD_SECONDS`` ahead of it), ``hud_rtf`` and ``hud_rtf_min`` the median and
   lowest real-time factor the HUD showed meanwhile (read every 0.25 s from 0.75 s after X);
 - ``fps_after_x``, ``steps_per_second`` and ``real_time_factor`` (the HUD's) over ``--seconds`` from
   one second after the landing;
@@ -98,8 +99,8 @@ def sim_steps():
 
 
 def sim_time():
-    clock = getattr(viewer.physics, "sim_time", None)
-    return clock() if clock is not None else sim.world.time
+    # the simulated time of the state the window shows now (the physics may have stepped ahead of it)
+    return viewer.physics.shown.time
 
 
 def tick(_dt):

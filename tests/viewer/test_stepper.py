@@ -9,8 +9,10 @@ import threading
 import time
 
 import numpy as np
+import pytest
 
 from ballpit.scene import Scene, default_appearance
+from ballpit.viewer import stepper
 from ballpit.viewer.handover import Needs, capture
 from ballpit.viewer.simulation import Phase, Simulation
 from ballpit.viewer.stepper import PhysicsThread
@@ -155,3 +157,71 @@ def test_the_handover_is_a_copy_that_later_steps_leave_alone():
     np.testing.assert_array_equal(shown.velocities, velocities)
     assert not np.array_equal(sim.world.spheres.positions, positions)
     assert shown.hud.time < sim.world.time and shown.trails is not None
+
+
+def _cost(sim: Simulation, dear_from: float, dear_until: float, factor: float) -> None:
+    """Each step between ``dear_from`` and ``dear_until`` (simulated s) takes ``factor`` times its dt of
+    wall time; the others next to none."""
+
+    def spend() -> None:
+        if dear_from <= sim.world.time < dear_until:
+            time.sleep(factor * sim.timestep)
+
+    sim.before_step.append(spend)
+
+
+def _shown_speed(physics: PhysicsThread, until: float) -> float:
+    """Simulated over wall seconds of what the window is shown, from now until the shown state
+    reaches ``until``."""
+    start, began = physics.shown.time, time.perf_counter()
+    while physics.shown.time < until:
+        time.sleep(0.002)
+        assert time.perf_counter() - began < 20
+    return (physics.shown.time - start) / (time.perf_counter() - began)
+
+
+@pytest.mark.slow
+def test_a_dear_stretch_after_a_cheap_one_is_shown_in_real_time_from_the_steps_taken_ahead(monkeypatch):
+    # The first second costs nothing, the next 0.4 s 1.5x real time, then nothing again: on average
+    # cheaper than real time, as pile.toml's fall and landing are. Running ahead, what the window shows
+    # keeps real time throughout; stepping on the wall clock alone, the dear stretch plays slowly.
+    speeds, ahead = {}, stepper.LEAD_SECONDS
+    for lead in (ahead, 0.0):
+        monkeypatch.setattr(stepper, "LEAD_SECONDS", lead)
+        sim = Simulation(line_of_balls(3))
+        _cost(sim, 1.0, 1.4, 1.5)
+        physics = PhysicsThread(sim)
+        try:
+            physics.submit(lambda s: s.start())
+            physics.run_free()
+            speeds[lead] = _shown_speed(physics, 1.6)
+            if lead:
+                assert sim.real_time_factor == pytest.approx(1.0, abs=0.05)  # the speed shown
+        finally:
+            physics.stop()
+    assert speeds[ahead] == pytest.approx(1.0, abs=0.04), speeds
+    assert speeds[0.0] < 0.9, speeds  # 1.6 s shown in 1.8 s of wall time
+
+
+def test_a_command_sent_while_the_run_is_ahead_acts_on_the_state_the_window_shows():
+    # The world is put back at the step the window shows (its kept snapshot, restored), exactly as the
+    # run had it there: a fresh run stepped that far has the same bits.
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim)
+    got = []
+    try:
+        physics.submit(lambda s: s.start())
+        physics.run_free()
+        assert wait_for(lambda: sim.world.time - physics.shown.time > 0.2)  # stepping ahead
+        ahead, shown = sim.world.time, physics.shown.time
+        physics.submit(lambda s: got.append((s.world.time, s.world.spheres.positions.copy())))
+        assert wait_for(lambda: got)
+    finally:
+        physics.stop()
+    at, positions = got[0]
+    assert shown <= at < ahead
+    fresh = line_of_balls(3)
+    while fresh.time < at - 0.5 * sim.timestep:
+        fresh.step(sim.timestep)
+    assert fresh.time == at
+    np.testing.assert_array_equal(positions, fresh.spheres.positions)

@@ -178,6 +178,12 @@ class Viewer:
     # ------------------------------------------------------------------ actions
     def perform(self, action: Action) -> None:
         """Do what a key asks for. What changes the World goes to the physics side as a command."""
+        needs = self._needs()
+        self._perform(action)
+        if self._needs() != needs:  # an overlay on or off: the states captured ahead lack it
+            self.physics.show_again()
+
+    def _perform(self, action: Action) -> None:
         do = self.command
         if action is Action.START:
             do(lambda sim: sim.start())
@@ -253,6 +259,13 @@ class Viewer:
             self.capture_mouse(False)
         self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
         self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
+
+    def _watched(self, result: tuple[bool, str | None]) -> None:
+        """The file watch's answer: the HUD's error, and a reload when the file changed."""
+        changed, error = result
+        self.hud.set_error(error)
+        if changed:
+            self.reload()
 
     def reload(self) -> None:
         """Ctrl+R / F5: the physics side loads the file again between steps; a failed reload keeps the
@@ -405,7 +418,8 @@ class Viewer:
         self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
             self._watch_at = now + WATCH_INTERVAL
-            self.command(lambda sim: (sim.file_changed() and sim.reload(), sim.error)[1], self.hud.set_error)
+            # reads the file's signature and the error alone: the steps taken ahead stay (stepper.py)
+            self.physics.submit(lambda sim: (sim.file_changed(), sim.error), self._watched, rewind=False)
         started = time.perf_counter()
         if dt is None:
             self.physics.run_free()

@@ -110,6 +110,8 @@ class Shown:
     error: str | None = None
     message: str = ""
     path: Any = None  # the scene file (for the HUD's save/reload messages)
+    time: float = 0.0  # the World's time (s) of the state copied
+    step: int | None = None  # its step in the history (None before the drop, or in a replay)
 
     @property
     def ball_count(self) -> int:
@@ -137,6 +139,8 @@ def capture(sim: Simulation, needs: Needs = Needs(), hud: HudFacts | None = None
         error=sim.error,
         message=sim.message,
         path=sim.path,
+        time=float(world.time),
+        step=sim.timeline.history.current if sim.timeline.history is not None else None,
     )
     if needs.velocities:
         shown.velocities = np.array(spheres.velocities, dtype=float)

@@ -48,6 +48,8 @@ class History:
         self._anchors: dict[int, Any] = {start: world.snapshot()}
         self._integrators: deque[str] = deque()  # the integrator of each step first+1 .. latest
         self._dense: dict[int, Any] = {}  # snapshots of the steps last re-stepped (fast stepping back)
+        # snapshots of steps taken ahead of what the window shows (stepper.py), to go back to at once
+        self._marks: dict[int, Any] = {}
         self.last_contacts: Any = None  # what the last step taken by ``seek`` returned
 
     # ------------------------------------------------------------------ the span
@@ -84,12 +86,26 @@ class History:
         and the changed state becomes an anchor, so re-stepping starts from it."""
         self.drop_future()
         self._dense.clear()
+        self._marks.pop(self.current, None)
         self._add_anchor(self.current)
+
+    def mark(self) -> None:
+        """Keep a snapshot of the current step until ``unmark_before`` passes it: the physics thread
+        running ahead of the window marks each step it hands over, so going back to the one shown
+        (``seek``) is one restore, not a re-stepping from the last anchor."""
+        self._marks[self.current] = self.world.snapshot()
+
+    def unmark_before(self, step: int) -> None:
+        """Forget the marks of the steps before ``step`` (the window shows it or a later one)."""
+        for k in [k for k in self._marks if k < step]:
+            del self._marks[k]
 
     def drop_future(self) -> None:
         """Forget every step after the current one."""
         if not self.in_past:
             return
+        for k in [k for k in self._marks if k > self.current]:
+            del self._marks[k]
         cut = bisect.bisect_right(self._anchor_steps, self.current)
         for step in self._anchor_steps[cut:]:
             del self._anchors[step]
@@ -122,6 +138,12 @@ class History:
         """
         step = int(min(max(step, self.first), self.latest))
         if step == self.current:
+            return step
+        if step in self._marks:
+            self.world.restore(self._marks[step])
+            self.current, self.last_contacts = step, None
+            if self.current < self.latest:
+                self.world.integrator = self._integrators[self.current - self.first]
             return step
         anchor = self._anchor_steps[bisect.bisect_right(self._anchor_steps, step) - 1]
         cached = max((k for k in self._dense if anchor <= k <= step), default=None)

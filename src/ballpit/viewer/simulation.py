@@ -310,6 +310,29 @@ class Simulation:
         self._update_stats(frame_seconds, steps)
         return steps
 
+    def lead(self, steps: int) -> int:
+        """Take up to ``steps`` fixed steps now, whatever the wall clock: the physics thread running ahead
+        of what the window shows (stepper.py). The state is handed over as it is, not interpolated, and
+        the simulated time counted for the real-time factor is the time shown (``count_shown``), not
+        the time stepped. Returns the steps taken."""
+        taken, stepped = 0, self._stats_sim
+        contacts: list = []
+        while taken < steps and self.phase is Phase.RUNNING:
+            self._step(contacts)
+            taken += 1
+        self._finish_steps(contacts)
+        self._stats_sim = stepped
+        self.accumulator, self.alpha = 0.0, 1.0
+        if taken:
+            self.timeline.sample_energy()
+        return taken
+
+    def count_shown(self, wall_seconds: float, shown_seconds: float) -> None:
+        """While running ahead: ``wall_seconds`` passed and the window's state moved on by
+        ``shown_seconds`` of simulated time (the real-time factor is the speed the run is shown at)."""
+        self._stats_sim += shown_seconds
+        self._update_stats(wall_seconds, 0)
+
     def _step(self, contacts: list) -> None:
         for hook in self.before_step:
             hook()

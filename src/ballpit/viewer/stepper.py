@@ -22,6 +22,18 @@ Two ways to run:
 - lockstep (``advance(dt)``): the caller's thread takes the lock and advances exactly ``dt`` of real
   time, applying the commands first. Tests and scripted runs use it for exact, repeatable frames.
 
+Running ahead. While a live run plays at real speed and nothing is asked of it, the thread does not
+wait for the wall clock: it steps up to LEAD_SECONDS ahead of what the window shows and queues a
+``Shown`` per LEAD_FRAME of simulated time, each due at the wall time its simulated time maps to; the
+window shows the latest one due (``shown``). What a cheap stretch saves pays for a dear one: pile.toml's
+fall costs 2-4 ms a 1/60 s frame and the heaviest part of its landing 18-22 ms, so beside the window
+it lands in real time instead of at 0.8 of it. When the queue runs dry the window shows each state as
+it comes, in slow motion, and the real-time factor (``Simulation.lead``) says so: it is the speed the
+run is shown at. Whatever the window asks (a key, a drag, B, Ctrl+S: every command but the file watch)
+is answered from the state it shows: the steps taken ahead are dropped first, the World put back at
+the step shown (``History.mark`` keeps a snapshot of each step handed over, so that is one restore),
+and the run goes on from there, as resuming from the past does.
+
 A thread rather than a process. First by benchmarks/physics_beside_drawing.py on a 2-core machine
 with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s with
 the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17 and
@@ -54,6 +66,10 @@ HUD_INTERVAL = 0.1  # seconds between readings of the HUD's facts (energy, drift
 IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no command came
 IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
 BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
+# s of wall time the physics may run ahead of what the window shows while a live run plays (see
+# "Running ahead" above), and s of simulated time per hand-over meanwhile
+LEAD_SECONDS = 0.5
+LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = float(os.environ.get("BALLPIT_SWITCH", "0.001"))
@@ -70,7 +86,11 @@ class PhysicsThread:
         self.needs = needs  # what the window draws now (asked at each capture)
         self.lock = threading.Lock()  # held while the World changes: a step, a command, a capture
         self._handover_lock = threading.Lock()
-        self._commands: deque[tuple[Command, Then | None]] = deque()
+        self._commands: deque[tuple[Command, Then | None, bool]] = deque()
+        self._ahead: deque[tuple[float, Shown]] = deque()  # (due wall time, state), oldest first
+        self._base: tuple[float, float] | None = None  # (wall, simulated) times that map to each other
+        self._counted = (0.0, 0.0)  # (wall, simulated time shown) when the factor was last fed
+        self._rewind = False  # the window asked for the state it shows (what it draws changed)
         self._results: deque[tuple[Then, Any]] = deque()
         self._wake = threading.Event()
         self._free = False
@@ -96,13 +116,28 @@ class PhysicsThread:
     # ------------------------------------------------------------------ the window's side
     @property
     def shown(self) -> Shown:
-        """The latest finished state handed over."""
+        """The latest finished state handed over that is due now (see "Running ahead")."""
         with self._handover_lock:
-            return self._shown
+            return self._take_due(time.perf_counter())
 
-    def submit(self, command: Command, then: Then | None = None) -> None:
-        """Run ``command(sim)`` on the physics side between steps; ``then(result)`` later in ``deliver``."""
-        self._commands.append((command, then))
+    def _take_due(self, now: float) -> Shown:
+        """The queued states due by ``now`` become the one shown (call it under the hand-over lock)."""
+        ahead = self._ahead
+        while ahead and ahead[0][0] <= now:
+            self._shown = ahead.popleft()[1]
+        return self._shown
+
+    def submit(self, command: Command, then: Then | None = None, rewind: bool = True) -> None:
+        """Run ``command(sim)`` on the physics side between steps; ``then(result)`` later in ``deliver``.
+        With ``rewind`` (the default) the command acts on the state the window shows: steps taken
+        ahead of it are dropped first. Only what reads nothing the steps change may pass False."""
+        self._commands.append((command, then, rewind))
+        self._wake.set()
+
+    def show_again(self) -> None:
+        """What the window draws changed (an overlay on or off): hand the shown state over again, with
+        it, instead of the states already captured ahead without it."""
+        self._rewind = True
         self._wake.set()
 
     def run_free(self) -> None:
@@ -117,6 +152,7 @@ class PhysicsThread:
         step in progress to end). Returns the steps taken."""
         self._free = False
         with self.lock:
+            self._rewind_to_shown()
             self._apply_commands()
             steps = self.sim.advance(seconds)
             self._publish(force_hud=False)
@@ -171,15 +207,26 @@ class PhysicsThread:
                 if not self._free or self._stopped:
                     continue
                 try:
+                    rewound = self._rewind or any(rewind for _, _, rewind in self._commands)
+                    if rewound:
+                        self._rewind_to_shown()
                     commands = self._apply_commands()
                     now = time.perf_counter()
                     if self._restart_clock:
                         self._restart_clock, last = False, now
-                    steps = self.sim.advance(now - last)
-                    last = now
-                    if steps or commands or now - published >= IDLE_HANDOVER:  # else the same as before:
-                        self._publish(force_hud=False)  # the window may keep the view it drew
-                        published = now
+                    ahead_wait = None
+                    if self._may_run_ahead():
+                        if rewound and commands:
+                            self._publish(force_hud=True)  # what the commands did, shown at once
+                        ahead_wait = self._run_ahead()
+                        last = published = now
+                    else:
+                        self._base = None
+                        steps = self.sim.advance(now - last)
+                        last = now
+                        if steps or commands or now - published >= IDLE_HANDOVER:  # else as before:
+                            self._publish(force_hud=False)  # the window may keep the view it drew
+                            published = now
                 except Exception as exc:  # never let the thread die silently: say why in the HUD
                     self.crash = f"physics thread stopped: {type(exc).__name__}: {exc}"
                     self.sim.error = self.crash
@@ -187,7 +234,9 @@ class PhysicsThread:
                     print(f"ballpit: {self.crash}", file=sys.stderr, flush=True)
                     return
                 sim = self.sim
-                if sim.phase is Phase.RUNNING:  # sleep until the next step is due, counting the
+                if ahead_wait is not None:
+                    wait = ahead_wait
+                elif sim.phase is Phase.RUNNING:  # sleep until the next step is due, counting the
                     # time this batch took as passed: a batch slower than real time owes a step now
                     owed = max(sim.timestep - sim.accumulator, 0.0) / max(sim.time_scale, 1e-9)
                     wait = owed - (time.perf_counter() - last)
@@ -215,7 +264,7 @@ class PhysicsThread:
         count = 0
         while self._commands:
             count += 1
-            command, then = self._commands.popleft()
+            command, then, _ = self._commands.popleft()
             try:
                 result = command(self.sim)
             except Exception as exc:  # a failed command is reported, the physics goes on
@@ -225,6 +274,79 @@ class PhysicsThread:
             if then is not None:
                 self._results.append((then, result))
         return count
+
+    # ------------------------------------------------------------------ running ahead
+    def _may_run_ahead(self) -> bool:
+        """A live run plays (after X, not paused, not a replay): its steps may be taken ahead."""
+        sim = self.sim
+        timeline = sim.timeline
+        return (
+            LEAD_SECONDS > 0.0
+            and sim.phase is Phase.RUNNING
+            and timeline.history is not None
+            and timeline.replay is None
+        )
+
+    def _run_ahead(self) -> float:
+        """Step one LEAD_FRAME of simulated time and queue the state, unless the run is LEAD_SECONDS
+        ahead of what the window shows already; returns how long to wait before the next batch."""
+        sim = self.sim
+        history = sim.timeline.history
+        scale = max(sim.time_scale, 1e-9)
+        now = time.perf_counter()
+        if self._base is None:  # the window shows the present: time what comes from here
+            self._base = (now, sim.world.time)
+            self._counted = (now, sim.world.time)
+            history.mark()
+        wall0, sim0 = self._base
+        shown = min(sim0 + (now - wall0) * scale, sim.world.time)  # the simulated time shown now
+        ahead = (sim.world.time - shown) / scale
+        if ahead >= LEAD_SECONDS:
+            self._count_shown(now, shown)
+            return min(ahead - LEAD_SECONDS + 1e-3, IDLE_WAIT)
+        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
+        history.mark()
+        state = self._capture(force_hud=False)
+        done = time.perf_counter()
+        due = wall0 + (state.time - sim0) / scale
+        if due <= done:  # behind: the window waits for this state: shown now, the rest timed from it
+            self._base, due = (done, state.time), done
+        wall0, sim0 = self._base
+        self._count_shown(done, min(sim0 + (done - wall0) * scale, state.time))
+        with self._handover_lock:
+            self._ahead.append((due, state))
+            step = self._take_due(done).step
+        if step is not None:
+            history.unmark_before(step)
+        return 0.0
+
+    def _count_shown(self, now: float, shown: float) -> None:
+        """The window's state had reached simulated time ``shown`` at wall time ``now``: the speed it is
+        shown at, for the real-time factor (both read at the same instants, so they add up)."""
+        wall, simulated = self._counted
+        self.sim.count_shown(now - wall, shown - simulated)
+        self._counted = (now, shown)
+
+    def _rewind_to_shown(self) -> None:
+        """Drop the states queued ahead of the one the window shows, and put the World back at it (the
+        future is dropped, as resuming from the past does): a command acts on what the user sees."""
+        asked, self._rewind = self._rewind, False
+        self._base = None
+        with self._handover_lock:
+            shown = self._take_due(time.perf_counter())
+            queued = len(self._ahead)
+            self._ahead.clear()
+        sim = self.sim
+        history = sim.timeline.history
+        step = shown.step if shown.generation == sim.generation else None
+        if queued and history is not None and step is not None and step < history.current:
+            sim.timeline.seek(step)
+            if sim.timeline.resumed():
+                for hook in sim.after_resume_from_past:
+                    hook(history.current)
+            asked = True
+        if asked:
+            self._publish(force_hud=True)
 
     def _capture(self, force_hud: bool) -> Shown:
         now = time.perf_counter()
@@ -241,4 +363,5 @@ class PhysicsThread:
         shown = self._capture(force_hud)
         self.capture_seconds += time.perf_counter() - started
         with self._handover_lock:
+            self._ahead.clear()
             self._shown = shown
