@@ -225,3 +225,23 @@ def test_a_command_sent_while_the_run_is_ahead_acts_on_the_state_the_window_show
         fresh.step(sim.timestep)
     assert fresh.time == at
     np.testing.assert_array_equal(positions, fresh.spheres.positions)
+
+
+def test_a_record_closed_while_the_run_is_ahead_ends_at_the_state_the_window_shows(tmp_path):
+    from ballpit.viewer.recording import Recorder
+
+    sim = Simulation(line_of_balls(3))
+    recorder = Recorder(tmp_path / "run.npz", sim)
+    physics = PhysicsThread(sim)
+    try:
+        physics.submit(lambda s: s.start())
+        physics.run_free()
+        assert wait_for(lambda: sim.world.time - physics.shown.time > 0.2)
+    finally:
+        physics.stop()
+    assert wait_for(lambda: not physics.alive)
+    shown = physics.shown
+    _, steps, _ = recorder.finish(shown.step)
+    assert steps == shown.step < sim.timeline.history.current  # the steps taken ahead are left out
+    with np.load(tmp_path / "run.npz") as run:
+        assert run["time"].max() == shown.time

@@ -23,7 +23,7 @@ from . import backend, controls
 from .controls import Action
 from .handover import Needs, Shown
 from .pacing import FramePacer
-from .simulation import Simulation
+from .simulation import Phase, Simulation
 
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
@@ -317,9 +317,12 @@ class Viewer:
 
     def finish_record(self) -> None:
         """Write the ``--record`` file (once), when the window closes or the run is interrupted: the
-        steps finished by then (a step still in progress on the physics thread is left out)."""
+        steps finished by then, up to the one shown (a step still in progress on the physics thread, or
+        taken ahead of what the window shows, is left out)."""
         if self.recorder is not None and not self.recorder.finished:
-            finished = self.recorder.finish()
+            shown, sim = self.physics.shown, self.sim
+            ahead = sim.phase is Phase.RUNNING and shown.generation == sim.generation  # may have run ahead
+            finished = self.recorder.finish(shown.step if ahead else None)
             if finished is not None:
                 path, steps, balls = finished
                 print(f"recorded {steps} steps ({balls} balls) to {path}", flush=True)

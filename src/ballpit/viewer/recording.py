@@ -80,13 +80,16 @@ class Recorder:
             self.writer = self._writer()
             self._record()
 
-    def finish(self) -> tuple[Path, int, int] | None:
-        """Write the file (once); returns (its path, the steps recorded, the balls), or None if it was
-        written already."""
+    def finish(self, shown: int | None = None) -> tuple[Path, int, int] | None:
+        """Write the file (once), up to the step ``shown`` (the one the window shows: steps the physics
+        took ahead of it were never seen); returns (its path, the steps recorded, the balls), or None if
+        it was written already."""
         with self._lock:
             if self.finished:
                 return None
             self.finished = True
+            if shown is not None and self.sim.timeline.history is not None:
+                self.writer.truncate(shown + 1)
             steps, balls = self.steps, self.writer.n
             self.writer.commit()
             return self.path, steps, balls
