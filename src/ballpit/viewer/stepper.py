@@ -67,8 +67,9 @@ IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no com
 IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
 BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
 # s of wall time the physics may run ahead of what the window shows while a live run plays (see
-# "Running ahead" above), and s of simulated time per hand-over meanwhile
-LEAD_SECONDS = 0.5
+# "Running ahead" above; BALLPIT_LEAD=0 turns it off, for comparisons), and s of simulated time per
+# hand-over meanwhile
+LEAD_SECONDS = float(os.environ.get("BALLPIT_LEAD", "0.5"))
 LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
