@@ -244,3 +244,35 @@ def test_a_step_that_would_carry_balls_beyond_the_steppable_range_is_undone_not_
     assert world.spheres.positions[:, 1] == pytest.approx(np.ones(10))  # where they were
     world.step(1 / 240)  # and the world steps on from there
     assert world.spheres.positions[0, 1] == pytest.approx(1 - 0.5 * 9.81 / 240**2)
+
+
+def test_a_heavy_ball_never_carries_a_light_one_through_a_wall_in_split_steps():
+    """#25: a 9.8 mm, 16 g ball in a corner of a closed box, a 8.5 mm, 0.75 kg ball just above it on
+    the line of a sideways gravity (5, −7, 4), split at impacts (RK2, 1/60 s). Gauss–Seidel hands the
+    heavy ball's weight through the light one at about 1/47 a sweep: the light ball sank 3.9 mm (0.4 of
+    its radius) into the walls in 4 steps, and at step 46 the heavy ball carried its centre through the
+    wall. Planes win (resting.hold_by_planes): it goes 0.7 mm into them at most (0.07 r), in at most 8
+    intervals a step."""
+    world = ballpit.World(gravity=(5.0, -7.0, 4.0), integrator="rk2")
+    side = 0.6
+    closed_box(world, side=side, restitution=0.0, friction=0.5)
+    world.crowd_limit = np.inf  # always split at impacts
+    light, heavy = 0.0098, 0.0085
+    corner = np.array([side / 2, 0.0, side / 2])
+    x_light = corner + np.array([-light, light, -light])
+    up = -np.array(world.gravity) / np.linalg.norm(world.gravity)
+    x_heavy = x_light + up * (light + heavy) * 1.01
+    world.add_spheres([x_light, x_heavy], radius=[light, heavy], mass=[0.016, 0.75], restitution=0.0)
+    radius = np.array([light, heavy])
+    worst, intervals = 0.0, 0
+    for _ in range(90):
+        world.step(1 / 60)
+        x = world.spheres.positions
+        # how far each ball's surface is beyond each wall, in radii
+        beyond = np.maximum(np.abs(x[:, [0, 2]]) + radius[:, None] - side / 2, 0.0).max(axis=1)
+        beyond = np.maximum(beyond, np.maximum(radius - x[:, 1], x[:, 1] + radius - side))
+        worst = max(worst, float((beyond / radius).max()))
+        intervals = max(intervals, world.profile.intervals)
+        assert inside(world, side)
+    assert worst < 0.1
+    assert intervals < 20

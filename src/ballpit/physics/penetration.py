@@ -15,7 +15,7 @@ from . import contact_model, exact, jacobi
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
-from .settings import JACOBI_FROM, OVERLAP_PER_RADIUS, OVERLAP_TOLERANCE, PENETRATION_SWEEPS
+from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, OVERLAP_TOLERANCE, PENETRATION_SWEEPS
 from .state import State, V, X, with_static
 
 
@@ -32,7 +32,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         jacobi.separate(c.a, c.b, c.normal, c.gap, rows.inv_mass_a, rows.inv_mass_b, pos, sweeps)
     else:
         _separate_by_colour(c, rows, pos)
-    new = keep_sides_of_planes(model, state, x, pos[:-1])
+    new = keep_sides_of_planes(model, state, x, pos[:-1], deeper=True)
     pay_for_lift(model, state, x, new, partly=True)
     x[:] = new
 
@@ -81,9 +81,12 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, p
     state.body[moved, V] = v * scale
 
 
-def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.ndarray) -> np.ndarray:
-    """``new`` positions, except that no ball's centre crosses a plane on its way from ``old``: one
-    that would is stopped where it touches the plane (or where it was, if it already overlapped it).
+def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.ndarray,
+                         deeper: bool = False) -> np.ndarray:  # fmt: skip
+    """``new`` positions, except that no ball's centre crosses a plane on its way from ``old``, nor
+    goes into one (``deeper``: the split step's push-apart) deeper than it touched or overlapped it
+    (beyond HOLD_SINK of its radius): such a ball is stopped where it touches the plane (or where it
+    was, if it already overlapped it). The soft step keeps its planes by solving every kept plane pair.
 
     Pushing apart many balls at one point can move a ball far along a normal that no plane contact
     limits (the plane was not within its reach), and planes are two-sided: through one, it would be
@@ -99,10 +102,18 @@ def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.nd
         d0 = exact.dot(start - pose.center[p], pose.normal[p])
         d1 = d0 + exact.dot(path, pose.normal[p])
         crossing = (d0 >= 0.0) != (d1 >= 0.0)
-        if not crossing.any():
+        # nor is a ball moved into a plane, deeper than it touched or overlapped it, by more than
+        # HOLD_SINK of its radius: that plane's contact may not be among the interval's touching
+        # ones (it was out of reach before the move), and the ball would fly on into it (#25)
+        floor = np.minimum(radius, np.abs(d0)) - HOLD_SINK * radius
+        into = ~crossing & (np.where(d0 >= 0.0, d1, -d1) < floor) & deeper
+        if not (crossing.any() or into.any()):
             continue
-        k = np.flatnonzero(crossing)
-        through = start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k]  # where the centre crosses
+        k = np.flatnonzero(crossing | into)
+        # where the centre crosses, or ends
+        through = np.where(
+            crossing[k, None], start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k], new[moved[k]]
+        )
         rel = through - pose.center[p]
         inside = (np.abs(exact.dot(rel, pose.axis_u[p])) <= half[p, 0]) & (
             np.abs(exact.dot(rel, pose.axis_v[p])) <= half[p, 1]

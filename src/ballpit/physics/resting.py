@@ -18,7 +18,7 @@ from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows, rows_at_end
-from .settings import JACOBI_FROM, WARM_START_SPAN
+from .settings import HOLD_PASSES, HOLD_SINK, JACOBI_FROM, WARM_START_SPAN
 from .state import State, V, W, with_static
 
 
@@ -157,7 +157,120 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
         rows = rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
+    hold_by_planes(rows, c.gap, model.spheres.radius, with_static(state.body[:, V]), v, min_normal_speed,
+                   imp.normal, h)  # fmt: skip
     if h >= WARM_START_SPAN * dt:
         warm.keep(keys, imp, h)
     events.add_resting(now, c, keys, imp.normal)
     return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)
+
+
+def hold_by_planes(rows: ContactRows, gap: np.ndarray, radius: np.ndarray, v_start: np.ndarray, v: np.ndarray,
+                   target: np.ndarray, normal: np.ndarray, h: float) -> None:  # fmt: skip
+    """Planes win: no ball the solve left sinking into a plane it touches by more than HOLD_SINK of its
+    radius over the interval is let sink at all. ``v_start`` and ``v`` (N+1, 3) are the velocities at
+    the interval's start and end (the end changes in place), ``normal`` the accumulated normal impulses
+    (changed in place), ``target`` each contact's least normal speed at the end.
+
+    Under a constant force a ball moves h·(v_n0 + v_n1)/2 along a normal over the interval. Gauss–Seidel
+    hands momentum through a light ball pressed between a heavy ball and a wall at about
+    m_light/m_heavy a sweep, so at a mass ratio of 47 its sweeps left the light ball sinking a quarter of
+    its radius a step, and the heavy ball pushed it through the wall (#25). Such a ball is held:
+
+    1. its plane contacts (and those on sleeping balls: every contact whose far side has no inverse
+       mass) are driven to their target, the ball alone moving (impulses only added: a hold pushes);
+    2. a ball pressing a held ball meets it as a ball that can move only along its planes: the held
+       ball's inverse mass along the contact normal n is |P·n|²/m, P the projection off the normals of
+       the planes now pushing it (Gram–Schmidt, elementwise). The impulse J = (target − v_n)/(1/m_a' +
+       1/m_b') stops the approach and moves the held ball by J·P·n/m, along its planes only: the
+       active-set answer the sweeps converge to, and like any inelastic impulse it adds no energy;
+    3. the whole impulse J·n acts on both balls, and the planes of every ball the hold moved are
+       driven to their target once more, last (planes win): they take off a held ball the part of J
+       they bear, so the kept impulses balance (the next interval's warm start pushes the held ball
+       into its planes and its planes back).
+    """
+    static = (rows.inv_mass_b == 0.0) & (rows.inv_mass_a > 0.0)
+    if not static.any():
+        return
+    n = rows.normal
+    vn0, vn1 = _normal_speeds(rows, v_start), _normal_speeds(rows, v)
+    r = radius[rows.a]
+    sink = 0.5 * h * (vn0 + vn1)
+    deeper = static & (gap + sink < np.minimum(gap, 0.0) - HOLD_SINK * r)
+    if not deeper.any():
+        return
+    balls = len(v)
+    held = np.zeros(balls, bool)
+    held[rows.a[deeper]] = True
+    planes = np.flatnonzero(static & held[rows.a])
+    _push_off_planes(rows, v, target, normal, planes)
+    # the normals of the planes pushing each held ball, made orthonormal (at most three)
+    slot = np.full(balls, -1)
+    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
+    basis = np.zeros((np.count_nonzero(held), 3, 3))
+    count = np.zeros(len(basis), np.intp)
+    pushing = planes[normal[planes] > 0.0]
+    for group in rows.subset(pushing).colours:  # one contact per ball in each colour
+        k = slot[rows.a[pushing[group]]]
+        u = _off(basis[k], n[pushing[group]])
+        length = exact.norm(u)
+        ok = (length > 1e-6) & (count[k] < 3)
+        k = k[ok]
+        basis[k, count[k]] = u[ok] / length[ok, None]
+        count[k] += 1
+    pressed = np.flatnonzero(~static & (held[rows.a] | held[rows.b]))
+    moved = held.copy()
+    if pressed.size:
+        sub = rows.subset(pressed)
+        for group in sub.colours:
+            idx = pressed[group]
+            a, b, nk = rows.a[idx], rows.b[idx], n[idx]
+            # each end's normal speed change per unit impulse: 1/m, or |P·n|²/m for a held ball
+            pa = np.where(held[a, None], _off(basis[slot[a]], nk), nk)
+            pb = np.where(held[b, None], _off(basis[slot[b]], nk), nk)
+            inverse = exact.dot(pa, pa) * rows.inv_mass_a[idx] + exact.dot(pb, pb) * rows.inv_mass_b[idx]
+            closing = np.maximum(target[idx] - exact.dot(v[a] - v[b], nk), 0.0)
+            j = np.where(inverse > 0.0, closing / np.where(inverse > 0.0, inverse, 1.0), 0.0)
+            normal[idx] += j
+            # the whole impulse acts on both balls; the planes take a held ball's part off it below
+            v[a] += (j * rows.inv_mass_a[idx])[:, None] * nk
+            v[b] -= (j * rows.inv_mass_b[idx])[:, None] * nk
+            moved[a[j > 0.0]] = True
+            moved[b[j > 0.0]] = True
+        v[-1] = 0.0
+    last = np.flatnonzero(static & moved[rows.a])
+    for _ in range(HOLD_PASSES):  # one is exact against square walls; a few for planes at an angle
+        _push_off_planes(rows, v, target, normal, last)
+
+
+def _normal_speeds(rows: ContactRows, v: np.ndarray, idx: np.ndarray | slice = slice(None)) -> np.ndarray:
+    """v_n of the contacts ``idx`` under the (N+1, 3) velocities ``v``, against a moving surface."""
+    nk = rows.normal[idx]
+    vn = exact.dot(v[rows.a[idx]] - v[rows.b[idx]], nk)
+    if rows.moving:
+        vn = vn - exact.dot(rows.surface[idx], nk)
+    return vn
+
+
+def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Each row of ``n`` (K, 3) less its parts along the rows of ``basis`` (K, 3, 3; orthonormal rows,
+    or zero rows), taken one after another."""
+    u = n.copy()
+    for j in range(3):
+        e = basis[:, j]
+        u = u - exact.dot(u, e)[:, None] * e
+    return u
+
+
+def _push_off_planes(rows: ContactRows, v: np.ndarray, target: np.ndarray, normal: np.ndarray,
+                     idx: np.ndarray) -> None:  # fmt: skip
+    """Drive the contacts ``idx`` (each against a body of no inverse mass) up to their target normal
+    speed by moving their ball alone, colour by colour; impulses are only added."""
+    if idx.size == 0:
+        return
+    for group in rows.subset(idx).colours:
+        k = idx[group]
+        a = rows.a[k]
+        j = np.maximum(target[k] - _normal_speeds(rows, v, k), 0.0) / rows.inv_mass_a[k]
+        normal[k] += j
+        v[a] += (j * rows.inv_mass_a[k])[:, None] * rows.normal[k]
