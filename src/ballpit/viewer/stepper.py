@@ -306,12 +306,13 @@ class PhysicsThread:
             self._count_shown(now, shown)
             return min(ahead - LEAD_SECONDS + 1e-3, IDLE_WAIT)
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
-        history.mark()
         state = self._capture(force_hud=False)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale
         if due <= done:  # behind: the window waits for this state: shown now, the rest timed from it
             self._base, due = (done, state.time), done
+        else:  # ahead: a command may come back to it
+            history.mark()
         wall0, sim0 = self._base
         self._count_shown(done, min(sim0 + (done - wall0) * scale, state.time))
         with self._handover_lock:
