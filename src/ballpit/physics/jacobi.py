@@ -29,7 +29,7 @@ import numpy as np
 from . import contact_model as model
 from .contact_model import Impulses
 from .rows import ContactRows
-from .settings import CONVERGED, SORT_ENDS_FROM
+from .settings import ADD_UP_BINS_UP_TO, CONVERGED, SORT_ENDS_FROM
 
 
 class Ends:
@@ -55,8 +55,14 @@ class Ends:
     def add_up(self, values: np.ndarray) -> np.ndarray:
         """(rows, 2K) values per contact end, summed per ball: (rows, M), with one ``np.bincount`` over
         all rows (row r's entries land in bins r·M + ball). bincount adds each bin's entries in their
-        order, so every sum is the same as one row at a time, at less than one call's cost a row."""
+        order, so every sum is the same as one row at a time, at less than one call's cost a row.
+        Beyond ADD_UP_BINS_UP_TO entries it is one call a row (the same sums), without keeping bins."""
         rows = len(values)
+        if rows * len(self.ends) > ADD_UP_BINS_UP_TO:
+            summed = np.empty((rows, self.m))
+            for r in range(rows):
+                summed[r] = np.bincount(self.ends, weights=values[r], minlength=self.m)
+            return summed
         flat = self._flat.get(rows)
         if flat is None:
             flat = (self.ends[None, :] + self.m * np.arange(rows)[:, None]).ravel()
@@ -186,14 +192,16 @@ def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tan
     ``push`` (6, 2K) is scratch."""
     k = c.k
     d_t, d_r = tangential[0], tangential[1]
-    linear = normal * c.n + d_t
-    turn = model.turn(c.n, d_t)
-    push[:3, :k] = linear
+    # formed in place in ``push`` (the same operations in the same order: no (3, K) temporaries)
+    linear, turn = push[:3, :k], push[3:, k:]
+    np.multiply(normal, c.n, out=linear)
+    linear += d_t
     np.negative(linear, out=push[:3, k:])
+    model.cross(c.n, d_t, out=turn)  # model.turn: n × P_t
     np.multiply(turn, c.minus_ra, out=push[3:, :k])
     push[3:, :k] += d_r
-    np.multiply(turn, c.minus_rb, out=push[3:, k:])
-    push[3:, k:] -= d_r
+    turn *= c.minus_rb
+    turn -= d_r
     total = c.add_up(push)
     total *= c.inverse
     vw += total
@@ -232,10 +240,13 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
     np.subtract(wa, wb, out=motion[1])
+    del g, va, wa, vb, wb, rel  # the gathered velocities: (6, 2K), the largest temporary of a sweep
     if c.spin is not None:
         motion[1] -= c.spin
-    new_tr = model.within_limit(tangential - c.m_tr * motion, c.limits * new)
-    d_tr = new_tr - tangential
+    candidate = c.m_tr * motion
+    np.subtract(tangential, candidate, out=candidate)
+    new_tr = model.within_limit(candidate, c.limits * new)
+    d_tr = np.subtract(new_tr, tangential, out=motion)  # the slip is used: its scratch takes the change
     apply(c, vw, push, d_n, d_tr)
     change = 0.0
     if measure:

@@ -185,11 +185,16 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
     )
     kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
+    del imp, added, level, vn_start
     warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
     body[idx, X] = x[:, live].T
     body[idx, V] = vw[:3, live].T
     body[idx, W] = vw[3:, live].T
     body[idx, Q] = q
+    # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now, so
+    # that moving overlaps apart does not hold them too (the peak memory of a settled pile)
+    whole = k.whole
+    del k, kept, tangential, vw, q, lin, ang, before, moved, target, scale, give, speculative
     # what the substeps left overlapping is moved apart by positions alone (penetration.py)
     # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
     # heap of balls created at one point is pushed apart, never launched by a jump of positions)
@@ -222,7 +227,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # each contact's load needs, s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))
     x[:, live] = body[idx, X].T
     s_end = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
-    s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
+    s_eq = normal * whole * impulse_scale / (mass_scale * bias_rate)
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
     return Frame(balls, total, least, farthest, largest, lo, hi)
