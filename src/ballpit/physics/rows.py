@@ -80,9 +80,12 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
         other = np.where(on_plane, plane[p] if len(plane) else 0.0, ball[o])
         return rule(ball[c.a], other)
 
-    surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
     moving = model.moving_planes()
+    # no moving plane: zero, one read-only row seen K times (read only while ``moving``; ``subset``
+    # takes real rows of it)
+    surface = spin = np.broadcast_to(np.zeros(3), (len(c), 3))
     if moving:  # a plane's surface moves at v + ω × (p − c) under the contact point
+        surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
         surface[on_plane] = moving_planes.surface_velocity(model, state, p[on_plane], c.point[on_plane])
         spin[on_plane] = pl.angular_velocity[p[on_plane]]
     ra, rb = radius[c.a], radius[c.b]

@@ -138,6 +138,8 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     apart = warm.apart_of(keys)
     normal = imp.normal.copy()
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
+    came_with = imp.normal  # the warm start's normal impulses; its friction and rolling are in tangential
+    del imp
     total = np.zeros(kc)
     least = c.gap.copy()
     farthest, largest = np.zeros(m), np.zeros(m)
@@ -184,8 +186,8 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
         g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
     )
-    kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
-    del imp, added, level, vn_start
+    kept = np.where((added != 0.0) & level, np.minimum(normal, came_with), normal)
+    del came_with, added, level, vn_start
     warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
     body[idx, X] = x[:, live].T
     body[idx, V] = vw[:3, live].T

@@ -67,6 +67,9 @@ class Step:
     profile: StepProfile
     intervals: int = 0
     doubt: str | None = None  # why a soft frame was undone and split at impacts instead (crowded_step)
+    # the (N, 13) block as the step found it (World.step's copy, read only): a soft frame undoes to it
+    # instead of copying it again (None: the frame copies)
+    before: np.ndarray | None = None
 
     def integrate(self, push: ForceTerm | None, h: float) -> None:
         """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``, and move
@@ -234,6 +237,7 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
+    del reach
     c = contacts.subset(solved)
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
@@ -260,7 +264,11 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     anything, and splitting a heap of overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
+    # the balls as the frame found them: the step's own copy when nothing has moved them since (a frame
+    # undone puts them back to it), so a settled pile holds one copy of its states, not two
+    first = step.before is not None and step.intervals == 0
+    body_before = step.before if first else state.body.copy()
+    planes_before = copy.deepcopy(state.planes)
     warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
     kept_before = step.pairs.kept
     with step.profile.stage("soft step"):

@@ -308,7 +308,8 @@ class World:
         planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
-                               model.restitution_threshold_for(dt), EventLog(), StepProfile())  # fmt: skip
+                               model.restitution_threshold_for(dt), EventLog(), StepProfile(),
+                               before=before)  # fmt: skip
         prof = step.profile
         with prof.stage("sleep"):
             sleep = state.sleep
