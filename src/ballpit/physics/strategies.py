@@ -239,6 +239,10 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
     c = contacts.subset(solved)
+    # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
+    # them): the kept pairs' own go, 48 bytes a pair (World.step measures them again if the step is
+    # split at impacts after all)
+    contacts.normal = contacts.point = None
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius

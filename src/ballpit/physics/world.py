@@ -344,6 +344,9 @@ class World:
         if crowd and strategies.crowded_step(step, contacts, (free, ang)):
             self.crowded_steps += 1
         else:
+            if contacts.normal is None:  # a soft frame tried and undone let go of them: the same again
+                with prof.stage("narrow phase"):
+                    contacts = narrowphase.contact_points(model, state, pairs)
             strategies.split_at_impacts(step, contacts, pairs, (free, ang))
         if model.sleep:
             with prof.stage("sleep"):
