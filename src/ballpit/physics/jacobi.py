@@ -61,7 +61,7 @@ class Ends:
         if rows * len(self.ends) > ADD_UP_BINS_UP_TO:
             summed = np.empty((rows, self.m))
             for r in range(rows):
-                summed[r] = np.bincount(self.ends, weights=values[r], minlength=self.m)
+                summed[r] = self.add_row(values[r])
             return summed
         flat = self._flat.get(rows)
         if flat is None:
@@ -69,6 +69,10 @@ class Ends:
             self._flat[rows] = flat
         summed = np.bincount(flat, weights=values.ravel(), minlength=rows * self.m)
         return summed.reshape(rows, self.m)
+
+    def add_row(self, values: np.ndarray) -> np.ndarray:
+        """One row of (2K,) values per contact end, summed per ball: (M,)."""
+        return np.bincount(self.ends, weights=values, minlength=self.m)
 
 
 class Contacts(Ends):
@@ -107,8 +111,10 @@ class Contacts(Ends):
         self.surface = np.ascontiguousarray(contacts.surface.T) if self.moving else None
         self.spin = np.ascontiguousarray(contacts.spin.T) if self.moving else None
         # scratch for what each contact adds to its a (columns :K) then its b (K:), and for the slip
-        # at the contact point and the relative spin (friction, rolling), kept for every sweep
-        self.push = np.empty((6, 2 * k))
+        # at the contact point and the relative spin (friction, rolling), kept for every sweep; beyond
+        # ADD_UP_BINS_UP_TO entries the pushes are made and added up one row at a time (``apply``), in
+        # one row of scratch instead of six (80 bytes a contact less)
+        self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
         self.motion = np.empty((2, 3, k))
         self.split()
 
@@ -189,9 +195,12 @@ def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | N
 def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray) -> None:
     """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both balls
     of every contact (``contact_model``: Δv = ±m⁻¹·(P_n·n + P_t), Δω = I⁻¹·(−ρ·n × P_t ± R));
-    ``push`` (6, 2K) is scratch."""
+    ``push`` (6, 2K) is scratch, or (1, 2K) to make and add up the pushes one row at a time."""
     k = c.k
     d_t, d_r = tangential[0], tangential[1]
+    if len(push) == 1:
+        _apply_by_rows(c, vw, push[0], normal, d_t, d_r)
+        return
     # formed in place in ``push`` (the same operations in the same order: no (3, K) temporaries)
     linear, turn = push[:3, :k], push[3:, k:]
     np.multiply(normal, c.n, out=linear)
@@ -207,6 +216,29 @@ def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tan
     vw += total
 
 
+def _apply_by_rows(c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray,
+                   d_r: np.ndarray) -> None:  # fmt: skip
+    """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
+    ball, are those of the (6, 2K) block."""
+    k, n = c.k, c.n
+    total = np.empty((6, c.m))
+    at_a, at_b = row[:k], row[k:]
+    for r in range(3):  # Δv: ±(P_n·n + P_t)
+        np.multiply(normal, n[r], out=at_a)
+        at_a += d_t[r]
+        np.negative(at_a, out=at_b)
+        total[r] = c.add_row(row)
+    for r in range(3):  # Δω: −ρ·(n × P_t) ± R
+        model.cross_component(n, d_t, r, out=at_b)
+        np.multiply(at_b, c.minus_ra, out=at_a)
+        at_a += d_r[r]
+        at_b *= c.minus_rb
+        at_b -= d_r[r]
+        total[3 + r] = c.add_row(row)
+    total *= c.inverse
+    vw += total
+
+
 def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, target: np.ndarray,
                   m_n: np.ndarray, give: np.ndarray | float | None) -> np.ndarray:  # fmt: skip
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
@@ -214,10 +246,18 @@ def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndar
     vn = normal_speeds(c, vw, n, c.surface)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
-    lin = push[:3]
-    np.multiply(d_n, n, out=lin[:, :k])
-    np.negative(lin[:, :k], out=lin[:, k:])
-    total = c.add_up(lin)
+    if len(push) == 1:  # one row at a time (``apply``)
+        total = np.empty((3, c.m))
+        row = push[0]
+        for r in range(3):
+            np.multiply(d_n, n[r], out=row[:k])
+            np.negative(row[:k], out=row[k:])
+            total[r] = c.add_row(row)
+    else:
+        lin = push[:3]
+        np.multiply(d_n, n, out=lin[:, :k])
+        np.negative(lin[:, :k], out=lin[:, k:])
+        total = c.add_up(lin)
     total *= c.inverse[:3]
     vw[:3] += total
     return new
@@ -230,17 +270,24 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     ``vw`` changes in place. Returns the impulses and (when ``measure``) a bound on the largest
     velocity change it made at any contact (m/s)."""
     k, n = c.k, c.n
-    g = np.take(vw, c.ends, axis=1)
-    va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
-    rel = model.contact_velocity(va, wa, vb, wb, n, c.ra, c.rb, c.surface)
+    ea, eb = c.ends[:k], c.ends[k:]
+    # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
+    # (3, K) part at a time, each dropped once used, not as one (6, 2K) block
+    wa, wb = np.take(vw[3:], ea, axis=1), np.take(vw[3:], eb, axis=1)
+    np.subtract(wa, wb, out=motion[1])  # the relative spin, for rolling resistance
+    lever = model.spin_lever(wa, wb, c.ra, c.rb)
+    del wa, wb
+    dv = np.take(vw[:3], ea, axis=1)
+    dv -= np.take(vw[:3], eb, axis=1)
+    rel = model.point_velocity(dv, lever, n, c.surface)
+    del lever
     vn = model.dot(rel, n)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
-    np.subtract(wa, wb, out=motion[1])
-    del g, va, wa, vb, wb, rel  # the gathered velocities: (6, 2K), the largest temporary of a sweep
+    del rel
     if c.spin is not None:
         motion[1] -= c.spin
     candidate = c.m_tr * motion
