@@ -100,7 +100,7 @@ class Contacts(Ends):
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
         inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
         inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = self.iia, self.iib
-        self.inverse = np.repeat(np.stack((inv_mass, inv_inertia)), 3, axis=0)  # (6, M)
+        self.inverse = np.stack((inv_mass, inv_inertia))  # (2, M): m⁻¹ for v's rows, I⁻¹ for ω's
         # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
         # velocity, for the convergence test
         inv_n, inv_t, _ = model.inverse_effective_masses(self.ima, self.imb, self.iia, self.iib, self.ra,
@@ -212,7 +212,8 @@ def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tan
     turn *= c.minus_rb
     turn -= d_r
     total = c.add_up(push)
-    total *= c.inverse
+    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
+    by_kind *= c.inverse[:, None, :]
     vw += total
 
 
@@ -235,7 +236,8 @@ def _apply_by_rows(c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndar
         at_b *= c.minus_rb
         at_b -= d_r[r]
         total[3 + r] = c.add_row(row)
-    total *= c.inverse
+    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
+    by_kind *= c.inverse[:, None, :]
     vw += total
 
 
@@ -258,7 +260,7 @@ def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndar
         np.multiply(d_n, n, out=lin[:, :k])
         np.negative(lin[:, :k], out=lin[:, k:])
         total = c.add_up(lin)
-    total *= c.inverse[:3]
+    total *= c.inverse[0]
     vw[:3] += total
     return new
 

@@ -33,7 +33,7 @@ from .state import State, V, X
 class KeptPairs:
     """Pairs the broad phase found for the coming steps, with the boxes they were found from."""
 
-    lo: np.ndarray  # (N, 3) swept boxes
+    lo: np.ndarray  # (N, 3) swept boxes (as found: views of the (3, N) columns, ``_columns``)
     hi: np.ndarray
     centre: np.ndarray  # (N, 3) and (N,): a sphere around each ball's swept path, tighter than its box
     reach: np.ndarray
@@ -233,13 +233,15 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     reach += pad
     lo -= pad
     hi += pad
-    rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), as kept
+    rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), for the broad phase
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
+    del rows  # kept as views of the columns: one copy of the boxes, not two (72 bytes a ball)
     counts = (model.spheres.count, model.planes.count)
     sides = plane_sides(model, state, s, p)
     still = ~model.moving_plane_mask()
-    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, still=still, _columns=(lo, hi, centre))
+    return KeptPairs(lo.T, hi.T, centre.T, reach, i, j, s, p, sides, counts, still=still,
+                     _columns=(lo, hi, centre))  # fmt: skip
 
 
 def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray, h: float,

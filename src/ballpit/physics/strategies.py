@@ -239,6 +239,9 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
     c = contacts.subset(solved)
+    # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.Contacts.n is
+    # then this memory, not a copy of it)
+    c.normal = np.asfortranarray(c.normal)
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
     # them): the kept pairs' own go, 48 bytes a pair (World.step measures them again if the step is
     # split at impacts after all)
