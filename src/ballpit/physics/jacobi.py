@@ -94,8 +94,9 @@ class Contacts(Ends):
         self.ra, self.rb = contacts.arm_lengths()
         self.minus_ra, self.minus_rb = -self.ra, -self.rb
         self.n = np.ascontiguousarray(contacts.normal.T)
-        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse
-        self.limits = np.stack((contacts.friction, contacts.rolling))
+        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse (the rows'
+        # own arrays: ``_full_sweep`` forms their (2, K) block for each sweep)
+        self.friction, self.rolling = contacts.friction, contacts.rolling
         # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
         inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
@@ -294,7 +295,10 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
         motion[1] -= c.spin
     candidate = c.m_tr * motion
     np.subtract(tangential, candidate, out=candidate)
-    new_tr = model.within_limit(candidate, c.limits * new)
+    limits = np.empty((2, k))
+    np.multiply(c.friction, new, out=limits[0])
+    np.multiply(c.rolling, new, out=limits[1])
+    new_tr = model.within_limit(candidate, limits)
     d_tr = np.subtract(new_tr, tangential, out=motion)  # the slip is used: its scratch takes the change
     apply(c, vw, push, d_n, d_tr)
     change = 0.0

@@ -37,7 +37,7 @@ class KeptPairs:
     hi: np.ndarray
     centre: np.ndarray  # (N, 3) and (N,): a sphere around each ball's swept path, tighter than its box
     reach: np.ndarray
-    pair_i: np.ndarray  # sphere–sphere pairs, i < j
+    pair_i: np.ndarray  # sphere–sphere pairs, i < j (int32 while the balls' rows fit: ``find_pairs``)
     pair_j: np.ndarray
     sphere: np.ndarray  # sphere–plane pairs
     plane: np.ndarray
@@ -235,6 +235,8 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     hi += pad
     rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), for the broad phase
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
+    if n < 2**31:  # kept for many steps: 4 bytes a ball index, not 8 (the narrow phase widens them)
+        i, j = i.astype(np.int32), j.astype(np.int32)
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
     del rows  # kept as views of the columns: one copy of the boxes, not two (72 bytes a ball)
     counts = (model.spheres.count, model.planes.count)

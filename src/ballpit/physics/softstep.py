@@ -128,9 +128,10 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     surface_n = dot(k.surface, n) if k.surface is not None else None
     hertz = min(CONTACT_HERTZ, 0.25 / h)
     ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
-    bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
-    mass_scale = np.where(on_plane, plane_soft.mass_scale, ball_soft.mass_scale)
-    impulse_scale = np.where(on_plane, plane_soft.impulse_scale, ball_soft.impulse_scale)
+
+    def soft(name: str) -> np.ndarray:  # each contact's coefficient, made when used (not kept: K floats)
+        return np.where(on_plane, getattr(plane_soft, name), getattr(ball_soft, name))
+
     vn_start = _normal_speed(k, vw)  # recorded at the frame's start, for the restitution pass
 
     keys = c.keys()
@@ -157,8 +158,9 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # the contacts that can push this substep: pressed already, or closing faster than their gap
         k.split((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
         speculative = s > 0.0
-        target = np.where(speculative, -s / h, np.minimum(-bias_rate * (s - apart), MAX_PUSH))
-        scale, give = np.where(speculative, 1.0, mass_scale), np.where(speculative, 0.0, impulse_scale)
+        target = np.where(speculative, -s / h, np.minimum(-soft("bias_rate") * (s - apart), MAX_PUSH))
+        scale = np.where(speculative, 1.0, soft("mass_scale"))
+        give = np.where(speculative, 0.0, soft("impulse_scale"))
         normal, tangential = _soft_sweeps(k, vw, normal, tangential, target, scale, give, SOLVE_SWEEPS)
         # 4. integrate positions (and orientations)
         before = x[:, live].copy()
@@ -173,6 +175,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # what the checks need: how far each ball got, and where
         moved = x[:, live] - before
         np.maximum(largest[live], _length(moved), out=largest[live])
+        del before, moved
         np.maximum(farthest[live], _length(x[:, live] - x0[:, live]), out=farthest[live])
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
@@ -196,7 +199,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now, so
     # that moving overlaps apart does not hold them too (the peak memory of a settled pile)
     whole = k.whole
-    del k, kept, tangential, vw, q, lin, ang, before, moved, target, scale, give, speculative
+    del k, kept, tangential, vw, q, lin, ang, target, scale, give, speculative
     # what the substeps left overlapping is moved apart by positions alone (penetration.py)
     # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
     # heap of balls created at one point is pushed apart, never launched by a jump of positions)
@@ -229,7 +232,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # each contact's load needs, s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))
     x[:, live] = body[idx, X].T
     s_end = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
-    s_eq = normal * whole * impulse_scale / (mass_scale * bias_rate)
+    s_eq = normal * whole * soft("impulse_scale") / (soft("mass_scale") * soft("bias_rate"))
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
     return Frame(balls, total, least, farthest, largest, lo, hi)

@@ -231,10 +231,10 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     model, state, dt, now = step.model, step.state, step.dt, step.state.time
     free, _ = accel
     radius = np.append(model.spheres.radius, np.inf)
-    v = with_static(state.body[:, V])
-    acc = with_static(free)
-    speed = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
-    pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
+    v, acc = state.body[:, V], free
+    # each ball's speed and pull, and 0 for the static row N
+    speed = np.append(np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]), 0.0)
+    pull = np.append(np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2]), 0.0)
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
@@ -243,9 +243,9 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     # then this memory, not a copy of it)
     c.normal = np.asfortranarray(c.normal)
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
-    # them): the kept pairs' own go, 48 bytes a pair (World.step measures them again if the step is
-    # split at impacts after all)
-    contacts.normal = contacts.point = None
+    # them), and b is N or other: the kept pairs' own go, 56 bytes a pair (World.step measures them
+    # again if the step is split at impacts after all)
+    contacts.normal = contacts.point = contacts.b = None
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
@@ -345,7 +345,8 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         out.gap = _gap_from(out, before, model, state)
     else:
         out = contacts.subset(~solved)
-        near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
+        b = np.where(out.kind == SPHERE_PLANE, n, out.other)  # crowded_step let go of contacts.b
+        near = far[out.a] + far[b] >= out.gap  # only those whose balls got farther than their gap
         out = out.subset(near)
         start = np.minimum(out.gap, 0.0)
         out.gap = _gap_from(out, before, model, state) - start
