@@ -167,7 +167,8 @@ def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarr
            converge: bool = False) -> tuple[np.ndarray, np.ndarray | None]:  # fmt: skip
     """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
     and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
-    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses.
+    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses. The ``tangential`` given
+    (a contiguous (2, 3, K) block) is taken as scratch by a full sweep: its values are not kept.
 
     Every ``friction_every``-th sweep and the last also update friction and rolling resistance (None:
     normal impulses alone). ``m_n`` and ``give`` make the normal soft (``contact_model.normal_impulse``;
@@ -293,13 +294,18 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     del rel
     if c.spin is not None:
         motion[1] -= c.spin
-    candidate = c.m_tr * motion
+    # the new impulses are formed in the slip's scratch and the change in the old impulses' block,
+    # which then is the next sweep's scratch: three (2, 3, K) blocks at a time, not four
+    candidate = motion
+    candidate *= c.m_tr
     np.subtract(tangential, candidate, out=candidate)
     limits = np.empty((2, k))
     np.multiply(c.friction, new, out=limits[0])
     np.multiply(c.rolling, new, out=limits[1])
     new_tr = model.within_limit(candidate, limits)
-    d_tr = np.subtract(new_tr, tangential, out=motion)  # the slip is used: its scratch takes the change
+    del limits
+    d_tr = np.subtract(new_tr, tangential, out=tangential)
+    c.motion = d_tr
     apply(c, vw, push, d_n, d_tr)
     change = 0.0
     if measure:
@@ -311,22 +317,34 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
              inv_mass_b: np.ndarray, pos: np.ndarray, sweeps: int) -> None:  # fmt: skip
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
-    proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world."""
+    proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world.
+
+    Every sweep works one coordinate at a time, on (K,) and (2K,) rows: the same operations in the same
+    order as on (3, K) blocks (v_n as ``contact_model.dot`` sums it, each row added up as ``add_up``
+    does), without their memory."""
     e = Ends(a, b)
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
-    wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
-    fa, fb = model.separation_parts(wa, wb)  # each end's part of the contact's correction
+    ea, eb = ends[:k], ends[k:]
+    fa, fb = model.separation_parts(share[ea] * inv_mass_a, share[eb] * inv_mass_b)  # each end's part
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
-    start = model.dot(n, np.take(x, ends[:k], axis=1) - np.take(x, ends[k:], axis=1))
-    move = np.zeros((3, 2 * k))
+
+    def along() -> np.ndarray:  # n·(x_a − x_b) per contact
+        d = n[0] * (np.take(x[0], ea) - np.take(x[0], eb))
+        d += n[1] * (np.take(x[1], ea) - np.take(x[1], eb))
+        d += n[2] * (np.take(x[2], ea) - np.take(x[2], eb))
+        return d
+
+    start = along()
+    move = np.empty(2 * k)  # one coordinate's moves of every contact's a (:K) then b (K:)
     for _ in range(sweeps):
-        g = np.take(x, ends, axis=1)
-        now = gap + model.dot(n, g[:, :k] - g[:, k:]) - start
-        d = np.maximum(-now, 0.0) * n
-        np.multiply(d, fa, out=move[:, :k])
-        np.multiply(d, fb, out=move[:, k:])
-        # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
-        x += e.add_up(move) / share
+        now = gap + along() - start
+        deficit = np.maximum(-now, 0.0)
+        for r in range(3):
+            d = deficit * n[r]
+            np.multiply(d, fa, out=move[:k])
+            np.multiply(d, fb, out=move[k:])
+            # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
+            x[r] += e.add_row(move) / share
     pos[balls] = x.T
     pos[-1] = 0.0

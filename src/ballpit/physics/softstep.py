@@ -217,8 +217,10 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # farther apart than that, cannot be closed by moving these apart
         part = np.flatnonzero(made < -2.0 * made.min())
         pos = with_static(body[:, X])
-        jacobi.separate(c.a[part], c.b[part], c.normal[part], made[part], rows.inv_mass_a[part],
+        normals = np.take(c.normal.T, part, axis=1).T  # laid out as (3, K) columns, as separate reads them
+        jacobi.separate(c.a[part], c.b[part], normals, made[part], rows.inv_mass_a[part],
                         rows.inv_mass_b[part], pos, SEPARATE_SWEEPS)  # fmt: skip
+        del normals
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
