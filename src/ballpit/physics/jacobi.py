@@ -291,7 +291,7 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
-    del rel
+    del dv, rel
     if c.spin is not None:
         motion[1] -= c.spin
     # the new impulses are formed in the slip's scratch and the change in the old impulses' block,

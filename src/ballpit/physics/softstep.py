@@ -162,6 +162,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         scale = np.where(speculative, 1.0, soft("mass_scale"))
         give = np.where(speculative, 0.0, soft("impulse_scale"))
         normal, tangential = _soft_sweeps(k, vw, normal, tangential, target, scale, give, SOLVE_SWEEPS)
+        del scale, give
         # 4. integrate positions (and orientations)
         before = x[:, live].copy()
         x[:, live] += vw[:3, live] * h
@@ -199,7 +200,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now, so
     # that moving overlaps apart does not hold them too (the peak memory of a settled pile)
     whole = k.whole
-    del k, kept, tangential, vw, q, lin, ang, target, scale, give, speculative
+    del k, kept, tangential, vw, q, lin, ang, target, speculative
     # what the substeps left overlapping is moved apart by positions alone (penetration.py)
     # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
     # heap of balls created at one point is pushed apart, never launched by a jump of positions)
