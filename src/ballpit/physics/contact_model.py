@@ -52,13 +52,20 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Column-wise a × b of (3, K) arrays (each component as ``np.cross`` forms it)."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
-    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
-    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
+def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Column-wise a × b of (3, K) arrays (each component as ``np.cross`` forms it), into ``out`` if
+    given (it must not overlap ``a`` or ``b``)."""
+    if out is None:
+        out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    for i in range(3):
+        cross_component(a, b, i, out=out[i])
     return out
+
+
+def cross_component(a: np.ndarray, b: np.ndarray, i: int, out: np.ndarray | None = None) -> np.ndarray:
+    """Component ``i`` of the column-wise a × b: a_j·b_k − a_k·b_j with (i, j, k) in cyclic order."""
+    j, k = (i + 1) % 3, (i + 2) % 3
+    return np.subtract(a[j] * b[k], a[k] * b[j], out=out)
 
 
 def inverse_effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv_inertia_a: np.ndarray,
@@ -88,10 +95,24 @@ def contact_velocity(v_a: np.ndarray, w_a: np.ndarray, v_b: np.ndarray, w_b: np.
                      surface: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """The contact point's velocity of a relative to b, v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b), less the
     ``surface`` velocity of a moving plane (all (3, K); ρ the lever-arm lengths, (K,))."""
-    rel = v_a - v_b + cross(n, arm_a * w_a + arm_b * w_b)
+    return point_velocity(v_a - v_b, spin_lever(w_a, w_b, arm_a, arm_b), n, surface)
+
+
+def spin_lever(w_a: np.ndarray, w_b: np.ndarray, arm_a: np.ndarray, arm_b: np.ndarray) -> np.ndarray:
+    """ρ_a·ω_a + ρ_b·ω_b: what the spins add to the contact point's velocity, crossed with n."""
+    lever = arm_a * w_a
+    lever += arm_b * w_b
+    return lever
+
+
+def point_velocity(dv: np.ndarray, lever: np.ndarray, n: np.ndarray,
+                   surface: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """``contact_velocity`` from the relative velocity ``dv`` = v_a − v_b (changed in place and
+    returned) and the ``spin_lever``: dv + n × lever − surface."""
+    dv += cross(n, lever)
     if surface is not None:
-        rel -= surface
-    return rel
+        dv -= surface
+    return dv
 
 
 def normal_speed(
@@ -118,13 +139,15 @@ def normal_impulse(accumulated: np.ndarray, m_n: np.ndarray, target: np.ndarray,
 
 def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """``candidate`` impulses (vectors along the second-to-last axis of length 3: (3, K) or stacked
-    (2, 3, K)) scaled down to length ≤ ``limit``: the friction cone μ·P_n, or the rolling limit."""
+    (2, 3, K)) scaled down to length ≤ ``limit``: the friction cone μ·P_n, or the rolling limit.
+    ``candidate`` is scaled in place (every caller passes a temporary) and returned."""
     x, y, z = candidate[..., 0, :], candidate[..., 1, :], candidate[..., 2, :]
     length = x * x + y * y + z * z
     length += 1e-300  # no 0/0 at zero
     np.sqrt(length, out=length)
     scale = np.minimum(limit / length, 1.0)
-    return candidate * scale[..., None, :]
+    candidate *= scale[..., None, :]
+    return candidate
 
 
 def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

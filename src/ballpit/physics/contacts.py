@@ -78,7 +78,8 @@ class ContactPoints:
     """Every kept pair measured at the current positions; sphere–plane pairs first.
 
     ``b`` is the other ball's row, or the static row N for a plane; ``other`` is what the events
-    report as b (the plane's or the other ball's index).
+    report as b (the plane's or the other ball's index). A soft frame drops ``normal`` and ``point``
+    (None) of the kept pairs once it has taken the ones it solves (``strategies.crowded_step``).
     """
 
     kind: np.ndarray
@@ -95,9 +96,8 @@ class ContactPoints:
     def subset(self, mask: np.ndarray) -> ContactPoints:
         """The contacts where ``mask`` holds (or at the indices ``mask``), in their order."""
         idx = take_indices(mask)
-        return ContactPoints(
-            **{f.name: np.take(getattr(self, f.name), idx, axis=0) for f in fields(ContactPoints)}
-        )
+        parts = {f.name: getattr(self, f.name) for f in fields(ContactPoints)}
+        return ContactPoints(**{k: None if v is None else np.take(v, idx, axis=0) for k, v in parts.items()})
 
     @staticmethod
     def concatenate(parts: list[ContactPoints]) -> ContactPoints:

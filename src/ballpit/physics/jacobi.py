@@ -29,7 +29,7 @@ import numpy as np
 from . import contact_model as model
 from .contact_model import Impulses
 from .rows import ContactRows
-from .settings import CONVERGED, SORT_ENDS_FROM
+from .settings import ADD_UP_BINS_UP_TO, CONVERGED, SORT_ENDS_FROM
 
 
 class Ends:
@@ -55,14 +55,24 @@ class Ends:
     def add_up(self, values: np.ndarray) -> np.ndarray:
         """(rows, 2K) values per contact end, summed per ball: (rows, M), with one ``np.bincount`` over
         all rows (row r's entries land in bins r·M + ball). bincount adds each bin's entries in their
-        order, so every sum is the same as one row at a time, at less than one call's cost a row."""
+        order, so every sum is the same as one row at a time, at less than one call's cost a row.
+        Beyond ADD_UP_BINS_UP_TO entries it is one call a row (the same sums), without keeping bins."""
         rows = len(values)
+        if rows * len(self.ends) > ADD_UP_BINS_UP_TO:
+            summed = np.empty((rows, self.m))
+            for r in range(rows):
+                summed[r] = self.add_row(values[r])
+            return summed
         flat = self._flat.get(rows)
         if flat is None:
             flat = (self.ends[None, :] + self.m * np.arange(rows)[:, None]).ravel()
             self._flat[rows] = flat
         summed = np.bincount(flat, weights=values.ravel(), minlength=rows * self.m)
         return summed.reshape(rows, self.m)
+
+    def add_row(self, values: np.ndarray) -> np.ndarray:
+        """One row of (2K,) values per contact end, summed per ball: (M,)."""
+        return np.bincount(self.ends, weights=values, minlength=self.m)
 
 
 class Contacts(Ends):
@@ -84,13 +94,14 @@ class Contacts(Ends):
         self.ra, self.rb = contacts.arm_lengths()
         self.minus_ra, self.minus_rb = -self.ra, -self.rb
         self.n = np.ascontiguousarray(contacts.normal.T)
-        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse
-        self.limits = np.stack((contacts.friction, contacts.rolling))
+        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse (the rows'
+        # own arrays: ``_full_sweep`` forms their (2, K) block for each sweep)
+        self.friction, self.rolling = contacts.friction, contacts.rolling
         # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
         inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
         inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = self.iia, self.iib
-        self.inverse = np.repeat(np.stack((inv_mass, inv_inertia)), 3, axis=0)  # (6, M)
+        self.inverse = np.stack((inv_mass, inv_inertia))  # (2, M): m⁻¹ for v's rows, I⁻¹ for ω's
         # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
         # velocity, for the convergence test
         inv_n, inv_t, _ = model.inverse_effective_masses(self.ima, self.imb, self.iia, self.iib, self.ra,
@@ -101,8 +112,10 @@ class Contacts(Ends):
         self.surface = np.ascontiguousarray(contacts.surface.T) if self.moving else None
         self.spin = np.ascontiguousarray(contacts.spin.T) if self.moving else None
         # scratch for what each contact adds to its a (columns :K) then its b (K:), and for the slip
-        # at the contact point and the relative spin (friction, rolling), kept for every sweep
-        self.push = np.empty((6, 2 * k))
+        # at the contact point and the relative spin (friction, rolling), kept for every sweep; beyond
+        # ADD_UP_BINS_UP_TO entries the pushes are made and added up one row at a time (``apply``), in
+        # one row of scratch instead of six (80 bytes a contact less)
+        self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
         self.motion = np.empty((2, 3, k))
         self.split()
 
@@ -154,7 +167,8 @@ def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarr
            converge: bool = False) -> tuple[np.ndarray, np.ndarray | None]:  # fmt: skip
     """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
     and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
-    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses.
+    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses. The ``tangential`` given
+    (a contiguous (2, 3, K) block) is taken as scratch by a full sweep: its values are not kept.
 
     Every ``friction_every``-th sweep and the last also update friction and rolling resistance (None:
     normal impulses alone). ``m_n`` and ``give`` make the normal soft (``contact_model.normal_impulse``;
@@ -183,19 +197,49 @@ def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | N
 def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray) -> None:
     """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both balls
     of every contact (``contact_model``: Δv = ±m⁻¹·(P_n·n + P_t), Δω = I⁻¹·(−ρ·n × P_t ± R));
-    ``push`` (6, 2K) is scratch."""
+    ``push`` (6, 2K) is scratch, or (1, 2K) to make and add up the pushes one row at a time."""
     k = c.k
     d_t, d_r = tangential[0], tangential[1]
-    linear = normal * c.n + d_t
-    turn = model.turn(c.n, d_t)
-    push[:3, :k] = linear
+    if len(push) == 1:
+        _apply_by_rows(c, vw, push[0], normal, d_t, d_r)
+        return
+    # formed in place in ``push`` (the same operations in the same order: no (3, K) temporaries)
+    linear, turn = push[:3, :k], push[3:, k:]
+    np.multiply(normal, c.n, out=linear)
+    linear += d_t
     np.negative(linear, out=push[:3, k:])
+    model.cross(c.n, d_t, out=turn)  # model.turn: n × P_t
     np.multiply(turn, c.minus_ra, out=push[3:, :k])
     push[3:, :k] += d_r
-    np.multiply(turn, c.minus_rb, out=push[3:, k:])
-    push[3:, k:] -= d_r
+    turn *= c.minus_rb
+    turn -= d_r
     total = c.add_up(push)
-    total *= c.inverse
+    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
+    by_kind *= c.inverse[:, None, :]
+    vw += total
+
+
+def _apply_by_rows(c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray,
+                   d_r: np.ndarray) -> None:  # fmt: skip
+    """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
+    ball, are those of the (6, 2K) block."""
+    k, n = c.k, c.n
+    total = np.empty((6, c.m))
+    at_a, at_b = row[:k], row[k:]
+    for r in range(3):  # Δv: ±(P_n·n + P_t)
+        np.multiply(normal, n[r], out=at_a)
+        at_a += d_t[r]
+        np.negative(at_a, out=at_b)
+        total[r] = c.add_row(row)
+    for r in range(3):  # Δω: −ρ·(n × P_t) ± R
+        model.cross_component(n, d_t, r, out=at_b)
+        np.multiply(at_b, c.minus_ra, out=at_a)
+        at_a += d_r[r]
+        at_b *= c.minus_rb
+        at_b -= d_r[r]
+        total[3 + r] = c.add_row(row)
+    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
+    by_kind *= c.inverse[:, None, :]
     vw += total
 
 
@@ -206,11 +250,19 @@ def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndar
     vn = normal_speeds(c, vw, n, c.surface)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
-    lin = push[:3]
-    np.multiply(d_n, n, out=lin[:, :k])
-    np.negative(lin[:, :k], out=lin[:, k:])
-    total = c.add_up(lin)
-    total *= c.inverse[:3]
+    if len(push) == 1:  # one row at a time (``apply``)
+        total = np.empty((3, c.m))
+        row = push[0]
+        for r in range(3):
+            np.multiply(d_n, n[r], out=row[:k])
+            np.negative(row[:k], out=row[k:])
+            total[r] = c.add_row(row)
+    else:
+        lin = push[:3]
+        np.multiply(d_n, n, out=lin[:, :k])
+        np.negative(lin[:, :k], out=lin[:, k:])
+        total = c.add_up(lin)
+    total *= c.inverse[0]
     vw[:3] += total
     return new
 
@@ -222,20 +274,38 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     ``vw`` changes in place. Returns the impulses and (when ``measure``) a bound on the largest
     velocity change it made at any contact (m/s)."""
     k, n = c.k, c.n
-    g = np.take(vw, c.ends, axis=1)
-    va, wa, vb, wb = g[:3, :k], g[3:, :k], g[:3, k:], g[3:, k:]
-    rel = model.contact_velocity(va, wa, vb, wb, n, c.ra, c.rb, c.surface)
+    ea, eb = c.ends[:k], c.ends[k:]
+    # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
+    # (3, K) part at a time, each dropped once used, not as one (6, 2K) block
+    wa, wb = np.take(vw[3:], ea, axis=1), np.take(vw[3:], eb, axis=1)
+    np.subtract(wa, wb, out=motion[1])  # the relative spin, for rolling resistance
+    lever = model.spin_lever(wa, wb, c.ra, c.rb)
+    del wa, wb
+    dv = np.take(vw[:3], ea, axis=1)
+    dv -= np.take(vw[:3], eb, axis=1)
+    rel = model.point_velocity(dv, lever, n, c.surface)
+    del lever
     vn = model.dot(rel, n)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
     np.multiply(vn, n, out=motion[0])
     np.subtract(rel, motion[0], out=motion[0])
-    np.subtract(wa, wb, out=motion[1])
+    del dv, rel
     if c.spin is not None:
         motion[1] -= c.spin
-    new_tr = model.within_limit(tangential - c.m_tr * motion, c.limits * new)
-    d_tr = new_tr - tangential
+    # the new impulses are formed in the slip's scratch and the change in the old impulses' block,
+    # which then is the next sweep's scratch: three (2, 3, K) blocks at a time, not four
+    candidate = motion
+    candidate *= c.m_tr
+    np.subtract(tangential, candidate, out=candidate)
+    limits = np.empty((2, k))
+    np.multiply(c.friction, new, out=limits[0])
+    np.multiply(c.rolling, new, out=limits[1])
+    new_tr = model.within_limit(candidate, limits)
+    del limits
+    d_tr = np.subtract(new_tr, tangential, out=tangential)
+    c.motion = d_tr
     apply(c, vw, push, d_n, d_tr)
     change = 0.0
     if measure:
@@ -247,22 +317,34 @@ def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, 
              inv_mass_b: np.ndarray, pos: np.ndarray, sweeps: int) -> None:  # fmt: skip
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
-    proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world."""
+    proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world.
+
+    Every sweep works one coordinate at a time, on (K,) and (2K,) rows: the same operations in the same
+    order as on (3, K) blocks (v_n as ``contact_model.dot`` sums it, each row added up as ``add_up``
+    does), without their memory."""
     e = Ends(a, b)
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
-    wa, wb = share[ends[:k]] * inv_mass_a, share[ends[k:]] * inv_mass_b
-    fa, fb = model.separation_parts(wa, wb)  # each end's part of the contact's correction
+    ea, eb = ends[:k], ends[k:]
+    fa, fb = model.separation_parts(share[ea] * inv_mass_a, share[eb] * inv_mass_b)  # each end's part
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
-    start = model.dot(n, np.take(x, ends[:k], axis=1) - np.take(x, ends[k:], axis=1))
-    move = np.zeros((3, 2 * k))
+
+    def along() -> np.ndarray:  # n·(x_a − x_b) per contact
+        d = n[0] * (np.take(x[0], ea) - np.take(x[0], eb))
+        d += n[1] * (np.take(x[1], ea) - np.take(x[1], eb))
+        d += n[2] * (np.take(x[2], ea) - np.take(x[2], eb))
+        return d
+
+    start = along()
+    move = np.empty(2 * k)  # one coordinate's moves of every contact's a (:K) then b (K:)
     for _ in range(sweeps):
-        g = np.take(x, ends, axis=1)
-        now = gap + model.dot(n, g[:, :k] - g[:, k:]) - start
-        d = np.maximum(-now, 0.0) * n
-        np.multiply(d, fa, out=move[:, :k])
-        np.multiply(d, fb, out=move[:, k:])
-        # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
-        x += e.add_up(move) / share
+        now = gap + along() - start
+        deficit = np.maximum(-now, 0.0)
+        for r in range(3):
+            d = deficit * n[r]
+            np.multiply(d, fa, out=move[:k])
+            np.multiply(d, fb, out=move[k:])
+            # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
+            x[r] += e.add_row(move) / share
     pos[balls] = x.T
     pos[-1] = 0.0

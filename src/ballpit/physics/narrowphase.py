@@ -26,8 +26,10 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
                                          pose.axis_u, pose.axis_v, model.planes.half_size)  # fmt: skip
     gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
     static = np.full(len(c.sphere), model.spheres.count)
+    kind = np.full(len(gp) + len(gs), SPHERE_SPHERE, np.int8)  # one byte a pair
+    kind[: len(gp)] = SPHERE_PLANE
     return ContactPoints(
-        kind=np.concatenate((np.full(len(gp), SPHERE_PLANE), np.full(len(gs), SPHERE_SPHERE))),
+        kind=kind,
         a=np.concatenate((c.sphere, c.pair_i)),
         b=np.concatenate((static, c.pair_j)),
         other=np.concatenate((c.plane, c.pair_j)),

@@ -33,11 +33,11 @@ from .state import State, V, X
 class KeptPairs:
     """Pairs the broad phase found for the coming steps, with the boxes they were found from."""
 
-    lo: np.ndarray  # (N, 3) swept boxes
+    lo: np.ndarray  # (N, 3) swept boxes (as found: views of the (3, N) columns, ``_columns``)
     hi: np.ndarray
     centre: np.ndarray  # (N, 3) and (N,): a sphere around each ball's swept path, tighter than its box
     reach: np.ndarray
-    pair_i: np.ndarray  # sphere–sphere pairs, i < j
+    pair_i: np.ndarray  # sphere–sphere pairs, i < j (int32 while the balls' rows fit: ``find_pairs``)
     pair_j: np.ndarray
     sphere: np.ndarray  # sphere–plane pairs
     plane: np.ndarray
@@ -233,13 +233,17 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     reach += pad
     lo -= pad
     hi += pad
-    rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), as kept
+    rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), for the broad phase
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
+    if n < 2**31:  # kept for many steps: 4 bytes a ball index, not 8 (the narrow phase widens them)
+        i, j = i.astype(np.int32), j.astype(np.int32)
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
+    del rows  # kept as views of the columns: one copy of the boxes, not two (72 bytes a ball)
     counts = (model.spheres.count, model.planes.count)
     sides = plane_sides(model, state, s, p)
     still = ~model.moving_plane_mask()
-    return KeptPairs(*rows, reach, i, j, s, p, sides, counts, still=still, _columns=(lo, hi, centre))
+    return KeptPairs(lo.T, hi.T, centre.T, reach, i, j, s, p, sides, counts, still=still,
+                     _columns=(lo, hi, centre))  # fmt: skip
 
 
 def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray, h: float,

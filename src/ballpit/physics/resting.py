@@ -54,7 +54,7 @@ class WarmStart:
         order = np.argsort(keys)
         self.keys = keys[order]
         parts = (imp.normal, imp.friction, imp.rolling)
-        self.forces = Impulses(*(part[order] / h for part in parts))
+        self.forces = Impulses(*(_divided(part[order], h) for part in parts))
         self.apart = np.zeros(len(keys))
 
     def put_to_sleep(self, asleep: np.ndarray) -> None:
@@ -95,6 +95,12 @@ class WarmStart:
     def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
         """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
         self.apart = apart[np.argsort(keys)]
+
+
+def _divided(x: np.ndarray, h: float) -> np.ndarray:
+    """x / h in place (x is a temporary): one array at a time, not two."""
+    x /= h
+    return x
 
 
 def _asleep_pairs(keys: np.ndarray, asleep: np.ndarray) -> np.ndarray:

@@ -29,8 +29,9 @@ class ContactRows:
     a: np.ndarray  # first ball
     b: np.ndarray  # second ball, or the static row N for a plane
     normal: np.ndarray  # (K, 3), towards a
-    arm_a: np.ndarray  # (K, 3) centre of a → contact point
-    arm_b: np.ndarray  # (K, 3) centre of b → contact point (zero for planes)
+    # the lever arms (centre → contact point) are r_a = −radius_a·n and r_b = radius_b·n (``arm_lengths``)
+    radius_a: np.ndarray  # (K,) a's radius
+    radius_b: np.ndarray  # (K,) b's radius, zero for planes
     inv_mass_a: np.ndarray
     inv_mass_b: np.ndarray
     inv_inertia_a: np.ndarray
@@ -47,9 +48,10 @@ class ContactRows:
         return len(self.a)
 
     def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
-        """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side."""
-        a, b = self.arm_a[idx], self.arm_b[idx]
-        return exact.norm(a), exact.norm(b)
+        """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side, as the lengths
+        of the lever arms −radius_a·n and radius_b·n (formed here and dropped: (K, 3) each)."""
+        n = self.normal[idx]
+        return exact.norm(-self.radius_a[idx, None] * n), exact.norm(self.radius_b[idx, None] * n)
 
     @cached_property
     def colours(self) -> list[np.ndarray]:
@@ -80,9 +82,12 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
         other = np.where(on_plane, plane[p] if len(plane) else 0.0, ball[o])
         return rule(ball[c.a], other)
 
-    surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
     moving = model.moving_planes()
+    # no moving plane: zero, one read-only row seen K times (read only while ``moving``; ``subset``
+    # takes real rows of it)
+    surface = spin = np.broadcast_to(np.zeros(3), (len(c), 3))
     if moving:  # a plane's surface moves at v + ω × (p − c) under the contact point
+        surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
         surface[on_plane] = moving_planes.surface_velocity(model, state, p[on_plane], c.point[on_plane])
         spin[on_plane] = pl.angular_velocity[p[on_plane]]
     ra, rb = radius[c.a], radius[c.b]
@@ -93,8 +98,8 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
         a=c.a,
         b=c.b,
         normal=c.normal,
-        arm_a=-ra[:, None] * c.normal,
-        arm_b=rb[:, None] * c.normal,
+        radius_a=ra,
+        radius_b=rb,
         inv_mass_a=inv_mass[c.a],
         inv_mass_b=inv_mass[c.b],
         inv_inertia_a=inv_inertia[c.a],
@@ -172,13 +177,12 @@ def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows,
     body, radius = state.body, model.spheres.radius[ball, None]
     centre = model.integrator.path_end(body[ball, 0:3], body[ball, 3:6], lin[ball] + push, h)
     plane_centre = state.planes.center[plane] + pl.velocity[plane] * h
-    normal, arm_a, surface = rows.normal.copy(), rows.arm_a.copy(), rows.surface.copy()
+    normal, surface = rows.normal.copy(), rows.surface.copy()
     normal[on] = turned
-    arm_a[on] = -radius * turned
     surface[on] = pl.velocity[plane] + moving_planes.cross(spin, centre - radius * turned - plane_centre)
     friction = warm.friction[on]
     warm.friction[on] = friction - _dot(friction, turned) * turned
-    end = replace(rows, normal=normal, arm_a=arm_a, surface=surface)
+    end = replace(rows, normal=normal, surface=surface)  # the lever arms turn with the normal
     if "colours" in rows.__dict__:  # the same contacts: the same colours
         end.__dict__["colours"] = rows.colours
     return end

@@ -172,6 +172,11 @@ JACOBI_FRICTION_EVERY = 4
 # A Jacobi solve numbers the balls its contacts touch by sorting the contact ends when the world has
 # more than this many balls per end (few contacts in a big world), else from a table over the world.
 SORT_ENDS_FROM = 8
+# A Jacobi solve adds up the rows of per-end values with one np.bincount over bins r·M + ball while
+# there are at most this many entries (rows × 2K): the bins are kept, 8 bytes an entry (1 MiB here).
+# Beyond it, one np.bincount a row, as fast at that size, and the bins are not kept: at 100,000 balls
+# they were 6 rows × 2 ends × 8 bytes a contact, about 290 bytes a ball in a settled pile.
+ADD_UP_BINS_UP_TO = 1 << 17
 # Resting forces found over less than this fraction of a step do not warm-start the next solve.
 WARM_START_SPAN = 0.5
 # Planes win (resting.hold_by_planes): when the resting solve leaves a ball sinking into a plane (or a

@@ -154,6 +154,7 @@ def after_step(model: Model, state: State, sleep: Sleep, c: ContactPoints, reach
     sleep.asleep[idx] = True
     body[idx, V] = 0.0
     body[idx, W] = 0.0
-    sleep.pose[idx, :3] = body[idx, X]
-    sleep.pose[idx, 3:] = body[idx, Q]
+    pose = sleep.poses()
+    pose[idx, :3] = body[idx, X]
+    pose[idx, 3:] = body[idx, Q]
     sleep.context = context(model, state)

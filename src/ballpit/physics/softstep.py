@@ -128,9 +128,10 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     surface_n = dot(k.surface, n) if k.surface is not None else None
     hertz = min(CONTACT_HERTZ, 0.25 / h)
     ball_soft, plane_soft = softness(hertz, DAMPING_RATIO, h), softness(2.0 * hertz, DAMPING_RATIO, h)
-    bias_rate = np.where(on_plane, plane_soft.bias_rate, ball_soft.bias_rate)
-    mass_scale = np.where(on_plane, plane_soft.mass_scale, ball_soft.mass_scale)
-    impulse_scale = np.where(on_plane, plane_soft.impulse_scale, ball_soft.impulse_scale)
+
+    def soft(name: str) -> np.ndarray:  # each contact's coefficient, made when used (not kept: K floats)
+        return np.where(on_plane, getattr(plane_soft, name), getattr(ball_soft, name))
+
     vn_start = _normal_speed(k, vw)  # recorded at the frame's start, for the restitution pass
 
     keys = c.keys()
@@ -138,6 +139,8 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     apart = warm.apart_of(keys)
     normal = imp.normal.copy()
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
+    came_with = imp.normal  # the warm start's normal impulses; its friction and rolling are in tangential
+    del imp
     total = np.zeros(kc)
     least = c.gap.copy()
     farthest, largest = np.zeros(m), np.zeros(m)
@@ -155,9 +158,11 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # the contacts that can push this substep: pressed already, or closing faster than their gap
         k.split((normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
         speculative = s > 0.0
-        target = np.where(speculative, -s / h, np.minimum(-bias_rate * (s - apart), MAX_PUSH))
-        scale, give = np.where(speculative, 1.0, mass_scale), np.where(speculative, 0.0, impulse_scale)
+        target = np.where(speculative, -s / h, np.minimum(-soft("bias_rate") * (s - apart), MAX_PUSH))
+        scale = np.where(speculative, 1.0, soft("mass_scale"))
+        give = np.where(speculative, 0.0, soft("impulse_scale"))
         normal, tangential = _soft_sweeps(k, vw, normal, tangential, target, scale, give, SOLVE_SWEEPS)
+        del scale, give
         # 4. integrate positions (and orientations)
         before = x[:, live].copy()
         x[:, live] += vw[:3, live] * h
@@ -171,6 +176,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # what the checks need: how far each ball got, and where
         moved = x[:, live] - before
         np.maximum(largest[live], _length(moved), out=largest[live])
+        del before, moved
         np.maximum(farthest[live], _length(x[:, live] - x0[:, live]), out=farthest[live])
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
@@ -184,12 +190,17 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
         g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
     )
-    kept = np.where((added != 0.0) & level, np.minimum(normal, imp.normal), normal)
+    kept = np.where((added != 0.0) & level, np.minimum(normal, came_with), normal)
+    del came_with, added, level, vn_start
     warm.keep(keys, Impulses(kept, tangential[0].T.copy(), tangential[1].T.copy()), h)
     body[idx, X] = x[:, live].T
     body[idx, V] = vw[:3, live].T
     body[idx, W] = vw[3:, live].T
     body[idx, Q] = q
+    # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now, so
+    # that moving overlaps apart does not hold them too (the peak memory of a settled pile)
+    whole = k.whole
+    del k, kept, tangential, vw, q, lin, ang, target, speculative
     # what the substeps left overlapping is moved apart by positions alone (penetration.py)
     # (an overlap the frame began with only as far as MAX_PUSH would have moved it in the frame: a
     # heap of balls created at one point is pushed apart, never launched by a jump of positions)
@@ -207,8 +218,10 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         # farther apart than that, cannot be closed by moving these apart
         part = np.flatnonzero(made < -2.0 * made.min())
         pos = with_static(body[:, X])
-        jacobi.separate(c.a[part], c.b[part], c.normal[part], made[part], rows.inv_mass_a[part],
+        normals = np.take(c.normal.T, part, axis=1).T  # laid out as (3, K) columns, as separate reads them
+        jacobi.separate(c.a[part], c.b[part], normals, made[part], rows.inv_mass_a[part],
                         rows.inv_mass_b[part], pos, SEPARATE_SWEEPS)  # fmt: skip
+        del normals
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
         penetration.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
@@ -222,7 +235,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
     # each contact's load needs, s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))
     x[:, live] = body[idx, X].T
     s_end = _separation(c.gap, n, x, x0, ends_a, ends_b, surface_n, dt)
-    s_eq = normal * k.whole * impulse_scale / (mass_scale * bias_rate)
+    s_eq = normal * whole * soft("impulse_scale") / (soft("mass_scale") * soft("bias_rate"))
     held = np.minimum(apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
     warm.keep_apart(keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
     return Frame(balls, total, least, farthest, largest, lo, hi)

@@ -95,7 +95,9 @@ class Sleep:
         self.rest = np.zeros(0)  # seconds each ball has been still
         self.asleep = np.zeros(0, bool)
         self.island = np.zeros(0, np.int64)  # which island a sleeping ball fell asleep with
-        self.pose = np.zeros((0, 7))  # x and q of each sleeping ball when it fell asleep
+        # x and q of each sleeping ball when it fell asleep: (N, 7) from the first fall (``poses``), (0, 7)
+        # in a world where nothing has slept
+        self.pose = np.zeros((0, 7))
         self.islands = 0  # islands put to sleep so far (their ids)
         self.context: tuple | None = None  # what every sleeping ball's rest depends on
 
@@ -107,7 +109,14 @@ class Sleep:
         self.rest = np.concatenate((self.rest, np.zeros(extra)))
         self.asleep = np.concatenate((self.asleep, np.zeros(extra, bool)))
         self.island = np.concatenate((self.island, np.zeros(extra, np.int64)))
-        self.pose = np.concatenate((self.pose, np.zeros((extra, 7))))
+        if len(self.pose):
+            self.pose = np.concatenate((self.pose, np.zeros((extra, 7))))
+
+    def poses(self) -> np.ndarray:
+        """``pose`` with a row for every ball (made when the first ball falls asleep)."""
+        if len(self.pose) != len(self.rest):
+            self.pose = np.zeros((len(self.rest), 7))
+        return self.pose
 
     @property
     def any(self) -> bool:

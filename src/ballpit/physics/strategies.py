@@ -67,6 +67,9 @@ class Step:
     profile: StepProfile
     intervals: int = 0
     doubt: str | None = None  # why a soft frame was undone and split at impacts instead (crowded_step)
+    # the (N, 13) block as the step found it (World.step's copy, read only): a soft frame undoes to it
+    # instead of copying it again (None: the frame copies)
+    before: np.ndarray | None = None
 
     def integrate(self, push: ForceTerm | None, h: float) -> None:
         """Advance every ball by ``h`` under the force terms, plus the contact forces ``push``, and move
@@ -228,13 +231,21 @@ def crowded_step(step: Step, contacts: ContactPoints, accel: tuple[np.ndarray, n
     model, state, dt, now = step.model, step.state, step.dt, step.state.time
     free, _ = accel
     radius = np.append(model.spheres.radius, np.inf)
-    v = with_static(state.body[:, V])
-    acc = with_static(free)
-    speed = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
-    pull = np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2])
+    v, acc = state.body[:, V], free
+    # each ball's speed and pull, and 0 for the static row N
+    speed = np.append(np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]), 0.0)
+    pull = np.append(np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2]), 0.0)
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
+    del reach
     c = contacts.subset(solved)
+    # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.Contacts.n is
+    # then this memory, not a copy of it)
+    c.normal = np.asfortranarray(c.normal)
+    # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
+    # them), and b is N or other: the kept pairs' own go, 56 bytes a pair (World.step measures them
+    # again if the step is split at impacts after all)
+    contacts.normal = contacts.point = contacts.b = None
     for substeps in [model.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
@@ -260,7 +271,11 @@ def _soft_frame(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     anything, and splitting a heap of overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    body_before, planes_before = state.body.copy(), copy.deepcopy(state.planes)
+    # the balls as the frame found them: the step's own copy when nothing has moved them since (a frame
+    # undone puts them back to it), so a settled pile holds one copy of its states, not two
+    first = step.before is not None and step.intervals == 0
+    body_before = step.before if first else state.body.copy()
+    planes_before = copy.deepcopy(state.planes)
     warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
     kept_before = step.pairs.kept
     with step.profile.stage("soft step"):
@@ -330,7 +345,8 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         out.gap = _gap_from(out, before, model, state)
     else:
         out = contacts.subset(~solved)
-        near = far[out.a] + far[out.b] >= out.gap  # only those whose balls got farther than their gap
+        b = np.where(out.kind == SPHERE_PLANE, n, out.other)  # crowded_step let go of contacts.b
+        near = far[out.a] + far[b] >= out.gap  # only those whose balls got farther than their gap
         out = out.subset(near)
         start = np.minimum(out.gap, 0.0)
         out.gap = _gap_from(out, before, model, state) - start

@@ -308,7 +308,8 @@ class World:
         planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
-                               model.restitution_threshold_for(dt), EventLog(), StepProfile())  # fmt: skip
+                               model.restitution_threshold_for(dt), EventLog(), StepProfile(),
+                               before=before)  # fmt: skip
         prof = step.profile
         with prof.stage("sleep"):
             sleep = state.sleep
@@ -343,6 +344,9 @@ class World:
         if crowd and strategies.crowded_step(step, contacts, (free, ang)):
             self.crowded_steps += 1
         else:
+            if contacts.normal is None:  # a soft frame tried and undone let go of them: the same again
+                with prof.stage("narrow phase"):
+                    contacts = narrowphase.contact_points(model, state, pairs)
             strategies.split_at_impacts(step, contacts, pairs, (free, ang))
         if model.sleep:
             with prof.stage("sleep"):
