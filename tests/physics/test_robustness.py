@@ -276,3 +276,32 @@ def test_a_heavy_ball_never_carries_a_light_one_through_a_wall_in_split_steps():
         assert inside(world, side)
     assert worst < 0.1
     assert intervals < 20
+
+
+@pytest.mark.parametrize("rate", [1e-160, 2.6e-195, 5e-324])
+@pytest.mark.parametrize("axis", [(0.0, 0.0, 1.0), (1.0, 1.0, 1.0)])
+def test_a_slope_spinning_absurdly_slowly_is_a_still_slope(rate, axis):
+    """#25: six coincident balls in a closed box on a tilted slope spinning at 2.6e-195 rad/s gave NaN
+    (FloatingPointError) as they reached it: the rate √(ω·ω) underflowed to 0 while ω did not, and the
+    turned contact normal divided ω by it. A plane turning slower than SLOWEST_TURN is still, everywhere
+    in the step: the balls take the still slope's path bit for bit."""
+
+    def slope_world(spin) -> tuple[ballpit.World, ballpit.Plane]:
+        world = ballpit.World()
+        closed_box(world)
+        slope = world.add_plane(
+            position=(0, 0.5, 0), normal=(0.3, 1, 0), size=(1.5, 1.5), angular_velocity=spin
+        )
+        world.add_spheres(np.tile([0.1, 1.0, 0.1], (6, 1)), radius=0.1)
+        return world, slope
+
+    spin = rate * np.array(axis)
+    world, slope = slope_world(spin)
+    still, _ = slope_world((0.0, 0.0, 0.0))
+    for _ in range(90):
+        world.step(1 / 60)
+        still.step(1 / 60)
+        assert np.isfinite(world.spheres.positions).all()
+        assert inside(world)
+        assert np.array_equal(world.spheres.positions, still.spheres.positions)
+    assert np.array_equal(slope.angular_velocity, spin)  # kept as written
