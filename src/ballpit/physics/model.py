@@ -12,7 +12,7 @@ import numpy as np
 from . import exact
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
-from .settings import CROWD_LIMIT, SOLVER_ITERATIONS
+from .settings import CROWD_LIMIT, SLOWEST_TURN, SOLVER_ITERATIONS
 from .state import Columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
@@ -96,14 +96,24 @@ class Model:
         return rows
 
     def moving_planes(self) -> bool:
-        """True when some plane has a velocity or an angular velocity."""
-        pl = self.planes
-        return bool(pl.velocity.any() or pl.angular_velocity.any())
+        """True when some plane has a velocity or turns (``plane_spin``)."""
+        return bool(self.planes.velocity.any() or self.plane_spin().any())
 
     def moving_plane_mask(self) -> np.ndarray:
-        """Which planes have a velocity or an angular velocity, one flag per plane."""
-        pl = self.planes
-        return pl.velocity.any(axis=1) | pl.angular_velocity.any(axis=1)
+        """Which planes have a velocity or turn (``plane_spin``), one flag per plane."""
+        return self.planes.velocity.any(axis=1) | self.plane_spin().any(axis=1)
+
+    def plane_spin(self) -> np.ndarray:
+        """Each plane's angular velocity as the step turns it (P, 3; read only): as written, but zero
+        for a plane turning slower than SLOWEST_TURN, whose rate cannot be formed from its squares.
+        Every stage of the step reads a plane's spin from here, so such a plane is still in all of them
+        alike (one turning in one stage and still in another could be missed by the time of impact)."""
+        spin = self.planes.angular_velocity
+        if not spin.any():
+            return spin
+        x, y, z = spin[:, 0], spin[:, 1], spin[:, 2]
+        still = (x * x + y * y) + z * z < SLOWEST_TURN * SLOWEST_TURN
+        return np.where(still[:, None], 0.0, spin) if still.any() else spin
 
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""

@@ -33,7 +33,7 @@ def advance(model: Model, state: State, h: float) -> None:
     without a dozen NumPy calls on one row each).
     """
     pl, pose = model.planes, state.planes
-    velocity, spin = pl.velocity, pl.angular_velocity
+    velocity, spin = pl.velocity, model.plane_spin()
     moving = np.flatnonzero(model.moving_plane_mask())
     if moving.size == 0:
         return
@@ -100,14 +100,14 @@ def surface_velocity(model: Model, state: State, plane: np.ndarray, points: np.n
     """Velocity of the surface of ``plane[k]`` at ``points[k]``: v + ω × (p − c)."""
     pl = model.planes
     offset = points - state.planes.center[plane]
-    return pl.velocity[plane] + cross(pl.angular_velocity[plane], offset)
+    return pl.velocity[plane] + cross(model.plane_spin()[plane], offset)
 
 
 def frames_at(model: Model, state: State, plane: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, ...]:
     """Centre and in-plane axes (u, v) of ``plane[k]`` after ``t[k]`` seconds of its motion."""
     pl, pose = model.planes, state.planes
     center = pose.center[plane] + pl.velocity[plane] * t[:, None]
-    spin = pl.angular_velocity[plane]
+    spin = model.plane_spin()[plane]
     rate = np.linalg.norm(spin, axis=1)
     axis = spin / np.where(rate > 0.0, rate, 1.0)[:, None]
     turn = quaternion.from_axis_angle(axis, rate * t)  # the identity where the plane does not turn
@@ -119,7 +119,7 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
     shift = _length(pl.velocity[plane].tolist()) * h
-    return shift + _length(pl.angular_velocity[plane].tolist()) * h * (distance + shift)
+    return shift + _length(model.plane_spin()[plane].tolist()) * h * (distance + shift)
 
 
 def _length(x: list[float]) -> float:
@@ -136,7 +136,7 @@ def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.
     dv = v - pl.velocity[plane]
     linear = np.linalg.norm(dv, axis=1) + np.linalg.norm(acc, axis=1) * h
     far = np.linalg.norm(state.body[ball, 0:3] - state.planes.center[plane], axis=1) + linear * h
-    return linear + np.linalg.norm(pl.angular_velocity[plane], axis=1) * far
+    return linear + np.linalg.norm(model.plane_spin()[plane], axis=1) * far
 
 
 def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -159,7 +159,7 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
     v_free, w_free = v.copy(), w.copy()
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
-    if rows.moving and model.planes.angular_velocity.any():  # the contacts at the interval's end
+    if rows.moving and model.plane_spin().any():  # the contacts at the interval's end
         rows = rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)

@@ -89,7 +89,7 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
     if moving:  # a plane's surface moves at v + ω × (p − c) under the contact point
         surface, spin = np.zeros((len(c), 3)), np.zeros((len(c), 3))
         surface[on_plane] = moving_planes.surface_velocity(model, state, p[on_plane], c.point[on_plane])
-        spin[on_plane] = pl.angular_velocity[p[on_plane]]
+        spin[on_plane] = model.plane_spin()[p[on_plane]]
     ra, rb = radius[c.a], radius[c.b]
     # Rolling resistance acts through the rolling radius: r for a ball on a plane, the reduced
     # radius 2·r_a·r_b/(r_a + r_b) between two balls.
@@ -160,13 +160,14 @@ def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows,
     """
     pl = model.planes
     on_plane = c.kind == SPHERE_PLANE
-    turning = pl.angular_velocity.any(axis=1)
+    spins = model.plane_spin()  # a plane too slow for its rate to be formed does not turn
+    turning = spins.any(axis=1)
     on = np.flatnonzero(on_plane & turning[np.where(on_plane, c.other, 0)])
     if on.size == 0:
         return rows
     plane, ball = c.other[on], c.a[on]
-    spin = pl.angular_velocity[plane]
-    rates = [math.sqrt(x * x + y * y + z * z) for x, y, z in pl.angular_velocity.tolist()]
+    spin = spins[plane]
+    rates = [math.sqrt(x * x + y * y + z * z) for x, y, z in spins.tolist()]
     sin_all, cos_all = exact.sin_cos(np.array(rates) * h)  # not math's: its bits depend on the CPU
     sin, cos = sin_all[plane, None], cos_all[plane, None]
     axis = spin / np.array(rates)[plane, None]

@@ -9,6 +9,9 @@ signatures the scene schema reads them from; the bounds on valid input stay in `
 
 from __future__ import annotations
 
+import math
+import sys
+
 # --- The step -------------------------------------------------------------------------------------
 
 # The step a scene, the viewer and the command line take unless told otherwise (s): 240 Hz.
@@ -17,6 +20,12 @@ DEFAULT_TIMESTEP = 1.0 / 240.0
 # conservatively: the balls that could meet anything stop where they are
 # (``strategies.finish_conservatively``). A pathological pile-up, not a textbook scene, gets there.
 MAX_INTERVALS = 1_000
+
+# A plane turns only at this rate or faster (rad/s, about 1.5e-154: the rate whose square is the
+# smallest normal double; ``Model.plane_spin``). Slower, the rate √(ω·ω) is formed from squares that
+# underflow (at 2.6e-195 rad/s it is 0 while ω is not, and ω / rate was NaN), and the plane would take
+# 1e140 years to turn a millionth of a radian: every stage of the step takes it as still.
+SLOWEST_TURN = math.sqrt(sys.float_info.min)
 
 # --- Contact ----------------------------------------------------------------------------------------
 

@@ -180,7 +180,7 @@ def earliest(model: Model, state: State, c: ContactPoints, apart: np.ndarray, x:
     if model.moving_planes():
         on = np.flatnonzero(c.kind[apart] == SPHERE_PLANE)
         pl, k = model.planes, c.other[apart[on]]
-        spin, rel = pl.angular_velocity[k], dv[on] - pl.velocity[k]  # v − v_p
+        spin, rel = model.plane_spin()[k], dv[on] - pl.velocity[k]  # v − v_p
         w = rel - exact.cross(spin, x[a[on]] - state.planes.center[k])
         norm = lambda q: np.sqrt(_dot(q, q))  # noqa: E731
         rate, accel = norm(spin), norm(da[on])
