@@ -332,7 +332,7 @@ class Simulation:
         ``shown_seconds`` of simulated time (the real-time factor is the speed the run is shown at)."""
         self._stats_sim += shown_seconds
         self._update_stats(wall_seconds, 0)
-        if self.real_time_factor == 0.0 and self._stats_wall > 0.0:  # before the first window's end
+        if self.real_time_factor == 0.0 and self._stats_wall >= 0.2 * STATS_WINDOW:  # before the first end
             self.real_time_factor = self._stats_sim / self._stats_wall
 
     def _step(self, contacts: list) -> None:
