@@ -31,7 +31,7 @@ it lands in real time instead of at 0.8 of it. When the queue runs dry the windo
 it comes, in slow motion, and the real-time factor (``Simulation.lead``) says so: it is the speed the
 run is shown at. Whatever the window asks (a key, a drag, B, Ctrl+S: every command but the file watch)
 is answered from the state it shows: the steps taken ahead are dropped first, the World put back at
-the step shown (``History.mark`` keeps a snapshot of each step handed over, so that is one restore),
+the step shown (``History.mark`` keeps a snapshot of each step queued ahead, so that is one restore),
 and the run goes on from there, as resuming from the past does.
 
 A thread rather than a process. First by benchmarks/physics_beside_drawing.py on a 2-core machine
