@@ -91,7 +91,7 @@ class History:
 
     def mark(self) -> None:
         """Keep a snapshot of the current step until ``unmark_before`` passes it: the physics thread
-        running ahead of the window marks each step it hands over, so going back to the one shown
+        running ahead of the window marks each step it queues ahead, so going back to the one shown
         (``seek``) is one restore, not a re-stepping from the last anchor."""
         self._marks[self.current] = self.world.snapshot()
 

@@ -205,12 +205,19 @@ class Simulation:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self.message = "resumed"
-            if self.timeline.resumed():
+            if self.resume_from_here():
                 self.message = "resumed from the past: the later history is dropped"
-                for hook in self.after_resume_from_past:
-                    hook(self.timeline.history.current)
         else:
             self.message = "press X to start the drop"
+
+    def resume_from_here(self) -> bool:
+        """The run goes on from the step the world is at: the later history is dropped and the hooks
+        (the recording) hear of it. False when the world was at the newest step already."""
+        if not self.timeline.resumed():
+            return False
+        for hook in self.after_resume_from_past:
+            hook(self.timeline.history.current)
+        return True
 
     def step_once(self) -> None:
         """N / →: one fixed step, only while paused."""

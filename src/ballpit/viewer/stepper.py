@@ -343,9 +343,7 @@ class PhysicsThread:
         step = shown.step if shown.generation == sim.generation else None
         if queued and history is not None and step is not None and step < history.current:
             sim.timeline.seek(step)
-            if sim.timeline.resumed():
-                for hook in sim.after_resume_from_past:
-                    hook(history.current)
+            sim.resume_from_here()
             asked = True
         if asked:
             self._publish(force_hud=True)
