@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, solver
+from . import contact_model, exact, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
@@ -250,12 +250,10 @@ def hold_by_planes(rows: ContactRows, gap: np.ndarray, radius: np.ndarray, v_sta
 
 
 def _normal_speeds(rows: ContactRows, v: np.ndarray, idx: np.ndarray | slice = slice(None)) -> np.ndarray:
-    """v_n of the contacts ``idx`` under the (N+1, 3) velocities ``v``, against a moving surface."""
-    nk = rows.normal[idx]
-    vn = exact.dot(v[rows.a[idx]] - v[rows.b[idx]], nk)
-    if rows.moving:
-        vn = vn - exact.dot(rows.surface[idx], nk)
-    return vn
+    """v_n of the contacts ``idx`` under the (N+1, 3) velocities ``v``, against a moving surface: the
+    contact model's ``normal_speed`` on these rows."""
+    surface = rows.surface[idx].T if rows.moving else None
+    return contact_model.normal_speed(v[rows.a[idx]].T, v[rows.b[idx]].T, rows.normal[idx].T, surface)
 
 
 def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
