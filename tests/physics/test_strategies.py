@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics import world as world_module
+from ballpit.physics import step as pipeline
 from ballpit.physics.profile import StepProfile
 from ballpit.physics.settings import CONTACT_SLOP, MAX_INTERVALS
 
@@ -31,7 +31,7 @@ def test_a_step_lands_the_same_whatever_count_its_profile_starts_from(monkeypatc
     dt = 1 / 60
     plain, timed = landing_world(), landing_world()
     plain.step(dt)
-    monkeypatch.setattr(world_module, "StepProfile", lambda: StepProfile(intervals=MAX_INTERVALS - 1))
+    monkeypatch.setattr(pipeline, "StepProfile", lambda: StepProfile(intervals=MAX_INTERVALS - 1))
     timed.step(dt)
     assert np.array_equal(timed.state.body, plain.state.body)
     assert timed.profile.intervals == plain.profile.intervals == 2

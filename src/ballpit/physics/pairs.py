@@ -141,29 +141,29 @@ class PairCache:
     """The kept pairs between steps. ``for_step`` reuses them while they still cover every path;
     ``renew`` replaces them when a path changes inside a step (a bounce or a contact force).
 
-    While some balls sleep, ``awake`` masks the balls and both hand out only the pairs with an awake
-    ball in them (the kept pairs themselves stay whole)."""
+    Both hand out only the pairs with a ball of ``awake`` in them (every pair when it is None: no ball
+    sleeps); the kept pairs themselves stay whole."""
 
     def __init__(self) -> None:
         self.kept: KeptPairs | None = None
-        self.awake: np.ndarray | None = None
 
-    def for_step(self, model: Model, state: State, accel: np.ndarray, dt: float) -> KeptPairs:
+    def for_step(self, model: Model, state: State, accel: np.ndarray, dt: float,
+                 awake: np.ndarray | None) -> KeptPairs:  # fmt: skip
         """The pairs for a step whose free acceleration is ``accel``: kept ones if they still hold."""
         c = self.kept
         counts = (model.spheres.count, model.planes.count)
         if c is None or c.counts != counts or c.escaped(model, state, accel, dt):
-            return self.renew(model, state, dt, BROAD_PHASE_STEPS * dt, accel, accel)
+            return self.renew(model, state, dt, BROAD_PHASE_STEPS * dt, accel, accel, awake)
         if model.moving_planes():  # the planes moved since the pairs were found
             refresh_moving(model, state, c, dt)
         c.side = plane_sides(model, state, c.sphere, c.plane)
-        return c.among(self.awake)
+        return c.among(awake)
 
     def renew(self, model: Model, state: State, h: float, ahead: float, accel: np.ndarray,
-              free: np.ndarray) -> KeptPairs:  # fmt: skip
+              free: np.ndarray, awake: np.ndarray | None) -> KeptPairs:  # fmt: skip
         """Find pairs afresh and keep them (they cover ``ahead`` seconds, so later steps reuse them)."""
         self.kept = find_pairs(model, state, h, ahead, accel, free)
-        return self.kept.among(self.awake)
+        return self.kept.among(awake)
 
 
 def refresh_moving(model: Model, state: State, c: KeptPairs, h: float) -> None:

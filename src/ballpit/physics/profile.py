@@ -9,19 +9,37 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from time import perf_counter
 
+
+class Stage:
+    """The names a step's time is reported under, one constant each (``profile.stage(Stage.PAIRS)``):
+    a timer asked for any other name fails, so no stage reports under a name of its own making."""
+
+    SLEEP = "sleep"
+    PAIRS = "pairs"
+    NARROW_PHASE = "narrow phase"
+    CROWD_TEST = "crowd test"
+    CONTACT_ROWS = "contact rows"
+    PENETRATION = "penetration"
+    IMPACTS = "impacts"
+    RESTING_SOLVE = "resting solve"
+    SOFT_STEP = "soft step"
+    TIME_OF_IMPACT = "time of impact"
+    INTEGRATE = "integrate"
+
+
 # The stages of a step, in the order a step runs them.
 STAGES = (
-    "pairs",
-    "narrow phase",
-    "crowd test",
-    "contact rows",
-    "penetration",
-    "impacts",
-    "resting solve",
-    "soft step",
-    "time of impact",
-    "integrate",
-    "sleep",
+    Stage.PAIRS,
+    Stage.NARROW_PHASE,
+    Stage.CROWD_TEST,
+    Stage.CONTACT_ROWS,
+    Stage.PENETRATION,
+    Stage.IMPACTS,
+    Stage.RESTING_SOLVE,
+    Stage.SOFT_STEP,
+    Stage.TIME_OF_IMPACT,
+    Stage.INTEGRATE,
+    Stage.SLEEP,
 )
 
 
@@ -50,7 +68,8 @@ class StepProfile:
     crowded: bool = False
 
     def stage(self, name: str) -> _Timer:
-        """``with profile.stage("impacts"): ...`` adds the block's time to that stage."""
+        """``with profile.stage(Stage.IMPACTS): ...`` adds the block's time to that stage (one of
+        ``STAGES``: any other name raises KeyError when the block ends)."""
         return _Timer(self.seconds, name)
 
 

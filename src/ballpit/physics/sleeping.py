@@ -108,14 +108,21 @@ def may_fall_asleep(sleep: Sleep, dt: float) -> bool:
     return bool(((sleep.rest + dt >= TIME_TO_SLEEP) & ~sleep.asleep).any())
 
 
-def after_step(model: Model, state: State, sleep: Sleep, c: ContactPoints, reach: np.ndarray | None,
+def links(c: ContactPoints, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ball–ball pairs (a, b) of ``c`` that join islands: those touching or within reach of each
+    other (``reach``, a mask over ``c``), whose balls would wake each other."""
+    linked = (c.kind == SPHERE_SPHERE) & (reach | (c.gap < CONTACT_SLOP))
+    return c.a[linked], c.other[linked]
+
+
+def after_step(model: Model, state: State, sleep: Sleep, joined: tuple[np.ndarray, np.ndarray] | None,
                dt: float) -> None:  # fmt: skip
     """Update the rest timers and put to sleep the islands whose balls have all been still for
     TIME_TO_SLEEP; wake any sleeping ball the step left moving.
 
-    Islands are joined by the ball–ball pairs of ``c`` (measured at the step's start) that touch or
-    were within reach of each other (``reach``): the pairs whose balls would wake each other.
-    ``reach`` may be None when no ball was asleep and none ``may_fall_asleep``: then none falls.
+    Islands are joined by the ball–ball pairs ``joined`` (``links`` of the contacts measured at the
+    step's start). They may be None when no ball was asleep and none ``may_fall_asleep``: then none
+    falls.
     """
     body = state.body
     n = len(body)
@@ -139,8 +146,7 @@ def after_step(model: Model, state: State, sleep: Sleep, c: ContactPoints, reach
     ready = awake & (sleep.rest >= TIME_TO_SLEEP)
     if not ready.any():
         return
-    linked = (c.kind == SPHERE_SPHERE) & (reach | (c.gap < CONTACT_SLOP))
-    a, b = c.a[linked], c.other[linked]
+    a, b = joined
     both = awake[a] & awake[b]
     label = islands(n, a[both], b[both])
     restless = np.unique(label[awake & ~ready])

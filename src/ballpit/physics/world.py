@@ -9,14 +9,14 @@ caches that change results: the broad phase's kept pairs (pairs.py) and the warm
 from __future__ import annotations
 
 import copy
-from time import perf_counter
 
 import numpy as np
 
-from . import energy, moving_planes, narrowphase, sleeping, strategies, validation
+from . import energy, moving_planes, validation
+from . import step as pipeline
 from .bodies import Plane, PlaneList, Sphere, SphereList
-from .contacts import ContactRecord, EventLog
-from .forces import ForceTerm, free_acceleration
+from .contacts import ContactRecord
+from .forces import ForceTerm
 from .integrators import INTEGRATORS, Workspace
 from .model import (
     BALL_MASS,
@@ -295,91 +295,31 @@ class World:
     def step(self, dt: float) -> ContactRecord:
         """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
 
-        Stages: waking what was changed by hand (sleeping.py), the kept pairs (found again only when
-        a path leaves its box), the narrow phase, waking the islands awake balls reach, the crowd
-        test, then one of the two strategies (strategies.py): split the step at every impact, or take
-        a crowded step as soft substeps (softstep.py); last, still islands fall asleep. ``profile``
-        then holds the step's time per stage.
+        The stages, as docs/architecture.md draws them (step/): refuse what cannot be stepped; wake
+        what was moved, collide, wake what the awake balls reach and collide again; the crowd test
+        plans the step; take it as a soft frame (retried with more substeps) or split at every impact;
+        still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
+        the step's time per stage.
         """
-        dt = validation.number("dt", dt, positive=True)
-        began = perf_counter()
-        model, state = self.model, self.state
-        validation.reject_unsteppable_state(state.body)
-        planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
-        before = state.body.copy()
-        step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
-                               model.restitution_threshold_for(dt), EventLog(), StepProfile(),
-                               before=before)  # fmt: skip
-        prof = step.profile
-        with prof.stage("sleep"):
-            sleep = state.sleep
-            sleeping.before_step(model, state, sleep, model.sleep)
-        free, ang, unheld = self._free_acceleration(step)
-        with prof.stage("pairs"):
-            pairs = self._pairs.for_step(model, state, free, dt)
-        with prof.stage("narrow phase"):
-            contacts = narrowphase.contact_points(model, state, pairs)
-        # Pairs within reach (sleeping balls counted as falling, as they will once awake) join islands;
-        # reaching a sleeping ball wakes its island. Needed only while some ball sleeps or may fall
-        # asleep at the end of this step.
-        reach = None
-        if model.sleep and (sleep.any or sleeping.may_fall_asleep(sleep, dt)):
-            with prof.stage("sleep"):
-                reach = strategies.speculative_reach(step, contacts, unheld)
-                woken = sleeping.reached(contacts, sleep.asleep, reach) if sleep.any else None
-            if woken is not None and woken.any():
-                sleep.wake(woken)
-                free, ang, unheld = self._free_acceleration(step)
-                with prof.stage("pairs"):
-                    pairs = self._pairs.for_step(model, state, free, dt)
-                with prof.stage("narrow phase"):
-                    contacts = narrowphase.contact_points(model, state, pairs)
-                with prof.stage("sleep"):
-                    reach = strategies.speculative_reach(step, contacts, unheld)
-        if model.sleep and len(self._warm.asleep[0]):
-            with prof.stage("sleep"):
-                self._warm.wake(sleep.asleep)  # the pairs of woken islands start from what they held
-        with prof.stage("crowd test"):
-            crowd = strategies.crowded(step, contacts, free)
-        if crowd and strategies.crowded_step(step, contacts, (free, ang)):
-            self.crowded_steps += 1
-        else:
-            if contacts.normal is None:  # a soft frame tried and undone let go of them: the same again
-                with prof.stage("narrow phase"):
-                    contacts = narrowphase.contact_points(model, state, pairs)
-            strategies.split_at_impacts(step, contacts, pairs, (free, ang))
-        if model.sleep:
-            with prof.stage("sleep"):
-                was = sleep.asleep.copy() if sleep.any or sleeping.may_fall_asleep(sleep, dt) else None
-                sleeping.after_step(model, state, sleep, contacts, reach, dt)
-                if was is not None and (sleep.asleep & ~was).any():
-                    self._warm.put_to_sleep(sleep.asleep)
-        validation.undo_non_finite_step(state.body, before)
-        if model.moving_planes():  # else the step left them as they were checked
-            self._remember_planes()
-        else:
-            self._good_planes = planes
-        state.time += dt
-        record = step.events.record()
-        prof.intervals, prof.pairs, prof.contacts = step.intervals, len(pairs), len(record)
-        prof.crowded = crowd
-        prof.total = perf_counter() - began
-        self.profile = prof
+        step = pipeline.prepare(self.model, self.state, self._pairs, self._warm, self._workspace, dt,
+                                self._good_planes)  # fmt: skip
+        awake = pipeline.wake(step)
+        plan = pipeline.plan(step, awake.collision, awake.motion)
+        taken = pipeline.solve(step, awake, plan)
+        pipeline.settle(step, awake)
+        record = pipeline.finish(step, plan, len(awake.collision.pairs))
+        self._after_step(step, taken)
         return record
 
-    def _free_acceleration(self, step: strategies.Step) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The free linear and angular accelerations at the step's start, and the linear ones had no
-        ball been asleep. While some sleep, the step's force terms get one more that holds them
-        (``step.forces`` changes)."""
-        step.forces = self.model.forces()
-        sleep = self.state.sleep
-        self._pairs.awake = ~sleep.asleep if sleep.any else None
-        free, ang = free_acceleration(self.state.body, step.forces)
-        if not sleep.any:
-            return free, ang, free
-        held = sleeping.hold(sleep, (free, ang))
-        step.forces.append(held)
-        return free + held.lin, ang + held.ang, free
+    def _after_step(self, step: pipeline.Step, taken: pipeline.Strategy) -> None:
+        """Keep what the next step checks against (the plane columns as this step left them) and
+        what it measured."""
+        if self.model.moving_planes():  # else the step left them as they were checked
+            self._remember_planes()
+        else:
+            self._good_planes = step.checked_planes
+        self.crowded_steps += taken is pipeline.Strategy.SOFT
+        self.profile = step.profile
 
     # ------------------------------------------------------------------ snapshots
     def snapshot(self) -> Snapshot:

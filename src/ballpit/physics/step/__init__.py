@@ -1,0 +1,78 @@
+"""A step as a pipeline of typed stages (docs/architecture.md draws it; ``World.step`` reads as it):
+
+    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> settle -> finish
+
+- ``prepare``: refuse what cannot be stepped; the step's settings and outputs (``Step``).
+- ``wake`` (sleep.py): wake what was moved by hand, collide (collide.py: the kept pairs and the
+  narrow phase), wake the islands the awake balls reach and collide again.
+- ``plan`` (plan.py): the crowd test, split at impacts or a soft frame of n substeps.
+- ``solve``: the soft frame (soft.py, softstep.py), tried with more substeps while it cannot keep its
+  promises, else the step split at every impact (split.py).
+- ``settle`` (sleep.py): still islands fall asleep.
+- ``finish``: undo a step that made anything non-finite; the time, the record and the profile.
+
+Each stage takes what it reads and returns what it makes; the world's parts it changes (state, kept
+pairs, warm start) are the ``Step``'s.
+"""
+
+from __future__ import annotations
+
+from time import perf_counter
+
+import numpy as np
+
+from .. import validation
+from ..contacts import ContactRecord, EventLog
+from ..integrators import Workspace
+from ..model import Model
+from ..pairs import PairCache
+from ..profile import StepProfile
+from ..resting import WarmStart
+from ..state import State
+from . import soft, split
+from .collide import measure
+from .context import Step
+from .plan import Plan, Strategy, plan
+from .sleep import Awake, settle, wake
+
+__all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "settle", "solve", "wake"]
+
+
+def prepare(model: Model, state: State, pairs: PairCache, warm: WarmStart, workspace: Workspace,
+            dt: float, good_planes: np.ndarray | None) -> Step:  # fmt: skip
+    """The step's context, once it is sure the engine can step the world: ValueError naming what it
+    cannot (a bad plane value is put back to ``good_planes``, the columns as the last step left them)."""
+    dt = validation.number("dt", dt, positive=True)
+    began = perf_counter()
+    validation.reject_unsteppable_state(state.body)
+    planes = validation.reject_bad_planes(model.planes, state.planes, good_planes)
+    threshold = model.restitution_threshold_for(dt)
+    return Step(model, state, pairs, warm, workspace, dt, threshold, EventLog(), StepProfile(), began, planes,
+                state.body.copy())  # fmt: skip
+
+
+def solve(step: Step, awake: Awake, chosen: Plan) -> Strategy:
+    """Take the step as ``chosen``: a soft frame (tried with more substeps while it cannot keep its
+    promises) or, when it is split or no try held, split at every impact. Returns how it was taken."""
+    collision = awake.collision
+    if chosen.strategy is Strategy.SOFT:
+        if soft.frames(step, awake.motion, collision, chosen):
+            return Strategy.SOFT
+        contacts = measure(step, collision.pairs)  # the frame took the contacts: the same again
+    else:
+        contacts = collision.take()
+    split.split_at_impacts(step, awake.motion, contacts, collision.pairs)
+    return Strategy.SPLIT
+
+
+def finish(step: Step, chosen: Plan, pairs: int) -> ContactRecord:
+    """Undo a step that made anything non-finite (or beyond what the engine can step) and raise;
+    else advance the time, and return the contacts resolved with the profile filled in."""
+    validation.undo_non_finite_step(step.state.body, step.before)
+    step.state.time += step.dt
+    record = step.events.record()
+    prof = step.profile
+    prof.intervals, prof.pairs, prof.contacts = step.intervals, pairs, len(record)
+    prof.crowded = chosen.strategy is Strategy.SOFT
+    prof.total = perf_counter() - step.began
+    return record

@@ -1,0 +1,53 @@
+"""What every stage of one step shares: the world's parts, the step's settings and what it has done."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import moving_planes
+from ..contacts import EventLog
+from ..forces import ForceTerm
+from ..integrators import Workspace, integrate
+from ..model import Model
+from ..pairs import PairCache
+from ..profile import Stage, StepProfile
+from ..resting import WarmStart
+from ..state import State
+
+
+@dataclass
+class Step:
+    """One step's context: the world's parts the stages read and change, the step's settings, and its
+    outputs (events, profile, intervals).
+
+    ``intervals`` counts the intervals integrated so far in this step: the strategies read it (is this
+    the first interval? is the bound MAX_INTERVALS reached?), and ``World.step`` copies it into the
+    profile at the end, which only measures.
+    """
+
+    model: Model
+    state: State
+    pairs: PairCache
+    warm: WarmStart
+    workspace: Workspace
+    dt: float
+    restitution_threshold: float  # m/s, approach speed below which nothing bounces
+    events: EventLog
+    profile: StepProfile
+    began: float  # perf_counter() when the step began
+    checked_planes: np.ndarray  # the plane columns as the step found them (validation.reject_bad_planes)
+    # the (N, 13) block as the step found it (read only): a soft frame undoes to it
+    before: np.ndarray
+    intervals: int = 0
+
+
+def integrate_interval(step: Step, forces: list[ForceTerm], push: ForceTerm | None, h: float) -> None:
+    """Advance every ball by ``h`` under the force terms ``forces``, plus the contact forces ``push``,
+    and move the planes along with them; one more interval of the step."""
+    with step.profile.stage(Stage.INTEGRATE):
+        terms = forces if push is None else [*forces, push]
+        integrate(step.model.integrator, step.state.body, terms, h, step.workspace)
+        moving_planes.advance(step.model, step.state, h)
+    step.intervals += 1

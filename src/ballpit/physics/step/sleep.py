@@ -1,0 +1,71 @@
+"""The sleep stages of a step (the rules are sleeping.py's): ``wake`` before the solve, with its loop
+of waking what the awake balls reach and measuring again, and ``settle`` after it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import sleeping
+from ..profile import Stage
+from .collide import Collision, Motion, collide
+from .context import Step
+from .plan import speculative_reach
+
+
+@dataclass
+class Awake:
+    """What the wake stage leaves for the step: the balls' free ``motion``, the ``collision`` measured
+    with every island that will move this step awake, and the ball–ball pairs that join islands
+    (``sleeping.links``; None when no ball sleeps or may fall asleep at the step's end)."""
+
+    motion: Motion
+    collision: Collision
+    links: tuple[np.ndarray, np.ndarray] | None
+
+
+def wake(step: Step) -> Awake:
+    """Wake what was moved or set moving by hand, collide, then wake the islands the awake balls touch
+    or could reach within the step and collide again with them awake; the woken islands' pairs get back
+    the warm start put aside when they fell asleep.
+
+    Pairs within reach (sleeping balls counted as falling, as they will once awake) join islands, so
+    the reach is needed only while some ball sleeps or may fall asleep at the end of this step.
+    """
+    model, state, prof = step.model, step.state, step.profile
+    sleep = state.sleep
+    with prof.stage(Stage.SLEEP):
+        sleeping.before_step(model, state, sleep, model.sleep)
+    motion = Motion.of(model, state)
+    collision = collide(step, motion)
+    links = None
+    if model.sleep and (sleep.any or sleeping.may_fall_asleep(sleep, step.dt)):
+        with prof.stage(Stage.SLEEP):
+            reach = speculative_reach(step, collision.contacts, motion.unheld)
+            woken = sleeping.reached(collision.contacts, sleep.asleep, reach) if sleep.any else None
+        if woken is not None and woken.any():
+            sleep.wake(woken)
+            motion = Motion.of(model, state)
+            collision = collide(step, motion)
+            with prof.stage(Stage.SLEEP):
+                reach = speculative_reach(step, collision.contacts, motion.unheld)
+        with prof.stage(Stage.SLEEP):
+            links = sleeping.links(collision.contacts, reach)
+    if model.sleep and len(step.warm.asleep[0]):
+        with prof.stage(Stage.SLEEP):
+            step.warm.wake(sleep.asleep)  # the pairs of woken islands start from what they held
+    return Awake(motion, collision, links)
+
+
+def settle(step: Step, awake: Awake) -> None:
+    """Still islands fall asleep (their pairs' warm start put aside); a sleeping ball the step left
+    moving wakes."""
+    model, state, sleep = step.model, step.state, step.state.sleep
+    if not model.sleep:
+        return
+    with step.profile.stage(Stage.SLEEP):
+        was = sleep.asleep.copy() if sleep.any or sleeping.may_fall_asleep(sleep, step.dt) else None
+        sleeping.after_step(model, state, sleep, awake.links, step.dt)
+        if was is not None and (sleep.asleep & ~was).any():
+            step.warm.put_to_sleep(sleep.asleep)

@@ -1,0 +1,222 @@
+"""A crowded step as one soft frame: contacts measured once, with a speculative margin (P. Firth,
+"Speculative contacts", 2011), then ``substeps`` soft-biased solves (Box2D v3's soft step,
+softstep.py). A frame that cannot keep its promises is undone and tried with more substeps; when no
+try holds, the step is split at impacts instead (split.py, which passes through nothing).
+"""
+
+from __future__ import annotations
+
+import copy
+from enum import Enum
+
+import numpy as np
+
+from .. import collision, moving_planes, narrowphase, softstep
+from ..contacts import SPHERE_PLANE, ContactPoints
+from ..forces import free_acceleration
+from ..integrators import integrate
+from ..model import Model
+from ..profile import Stage
+from ..settings import (
+    BROAD_PHASE_STEPS,
+    CONTACT_SLOP,
+    DEEP_OVERLAP,
+    RETRIES,
+    SPECULATIVE_REACH,
+    SUBSTEP_TRAVEL,
+)
+from ..state import State, V, X
+from .collide import Collision, Motion
+from .context import Step
+from .plan import Plan
+
+
+class Verdict(Enum):
+    """What the checks make of a soft frame: kept, or why it cannot be trusted (``frames``)."""
+
+    KEPT = "the frame kept its promises"
+    MOVED_TOO_FAR = "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
+    DEEPER = "a contact overlapped deeper than DEEP_OVERLAP (more than it did)"
+    LEFT_OUT = "a pair left out overlaps deeper than DEEP_OVERLAP"
+
+
+def frames(step: Step, motion: Motion, collision: Collision, plan: Plan) -> bool:
+    """The step as one soft frame of ``plan.substeps`` substeps (softstep.py) over the kept pairs of
+    ``collision`` that could meet within it; True when it was taken so (False: everything the tries
+    did is undone, and the step is to be split at impacts). The frame takes the collision's contacts
+    over (``Collision.take``).
+
+    A pair could meet within the frame if its gap is less than SPECULATIVE_REACH times the distance
+    its balls could cover towards each other at their own speeds, (|v_a| + |v_b| + (|a_a| + |a_b|)·dt)·dt
+    (with every plane), not at their relative speed: within a frame a ball's neighbours change speed
+    (the ball under it stops on the floor, the one beside it bounces back), so a pair falling together
+    meets at 5 m/s before the frame ends. Pairs at rest beside each other a fraction of a radius apart
+    are left out; a speculative pair pushes only if it closes faster than its gap allows.
+
+    The soft step keeps the walls only while every ball it moves travels less than SUBSTEP_TRAVEL of
+    its radius per substep, and while nothing it did not foresee happens. A frame is tried with twice
+    the substeps (at most RETRIES times) when some ball could travel farther before it starts, or
+    when it is undone after it because (``verdict``):
+
+    - a ball moved farther than that in a substep, or left the box its pairs were found from (then a
+      pair the broad phase never saw could have met);
+    - a solved contact overlapped deeper than DEEP_OVERLAP of the smaller radius at any substep's end;
+    - a pair left out of the contacts that could have met overlaps that deep at the end.
+
+    When no try holds, the step is split at impacts instead (split.py, which passes through nothing,
+    however fast).
+    """
+    model, state, dt, now = step.model, step.state, step.dt, step.state.time
+    radius = np.append(model.spheres.radius, np.inf)
+    v, acc = state.body[:, V], motion.lin
+    # each ball's speed and pull, and 0 for the static row N
+    speed = np.append(np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]), 0.0)
+    pull = np.append(np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2]), 0.0)
+    contacts = collision.take()
+    reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
+    solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
+    del reach
+    c = contacts.subset(solved)
+    # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.Contacts.n is
+    # then this memory, not a copy of it)
+    c.normal = np.asfortranarray(c.normal)
+    # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
+    # them), and of the others only which bodies they join and their gaps: the kept pairs' normals,
+    # points and b go, 56 bytes a pair
+    gaps = contacts.gaps()
+    del contacts
+    for substeps in [plan.substeps << k for k in range(RETRIES + 1)]:
+        h = dt / substeps
+        fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
+        if fast[c.a].any() or fast[c.b].any():  # too fast for a substep: not worth a try
+            continue
+        last = substeps == plan.substeps << RETRIES
+        frame = _try(step, motion, gaps, solved, c, substeps, last)
+        if frame is not None:
+            break
+    else:
+        return False
+    step.events.add(now, c, c.keys(), frame.impulse)
+    step.intervals += 1
+    return True
+
+
+def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c: ContactPoints,
+         substeps: int, last: bool) -> softstep.Frame | None:  # fmt: skip
+    """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone)
+    when its ``verdict`` is not KEPT. The ``last`` try is kept when its only fault is a solved contact
+    that overlapped DEEPER: that is no pass through anything, and splitting a heap of overlapping balls
+    at impacts jumps them apart by positions."""
+    model, state, dt = step.model, step.state, step.dt
+    n = model.spheres.count
+    # the balls as the frame found them: the step's own copy when nothing has moved them since (a frame
+    # undone puts them back to it), so a settled pile holds one copy of its states, not two
+    first = step.before is not None and step.intervals == 0
+    body_before = step.before if first else state.body.copy()
+    planes_before = copy.deepcopy(state.planes)
+    warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
+    kept_before = step.pairs.kept
+    with step.profile.stage(Stage.SOFT_STEP):
+        frame = softstep.frame(
+            model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps
+        )
+        balls = frame.balls[frame.balls < n]
+        others = np.ones(n, bool)
+        others[balls] = False
+        if not model.moving_planes():  # then nothing does work on the balls but gravity
+            softstep.hold_energy(model, state, body_before, balls)
+    if others.any():  # balls touching nothing this frame fly on the world's integrator
+        with step.profile.stage(Stage.INTEGRATE):
+            rows = state.body[others]
+            terms = softstep.compact_terms(motion.forces, np.flatnonzero(others), n)
+            integrate(model.integrator, rows, terms, dt, step.workspace)
+            state.body[others] = rows
+    moving_planes.advance(model, state, dt)
+    with step.profile.stage(Stage.TIME_OF_IMPACT):
+        found = verdict(step, motion, gaps, solved, c, frame, body_before)
+    if found is Verdict.KEPT or (last and found is Verdict.DEEPER):
+        return frame
+    state.body[:] = body_before  # undo it all
+    state.planes = planes_before
+    step.warm.keys, step.warm.forces, step.warm.apart = warm_before
+    step.pairs.kept = kept_before
+    return None
+
+
+def verdict(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c: ContactPoints,
+            frame: softstep.Frame, before: np.ndarray) -> Verdict:  # fmt: skip
+    """Whether a soft frame kept its promises (see ``frames``), or why it cannot be trusted.
+
+    ``gaps`` are the kept pairs' gaps at the frame's start (``ContactPoints.gaps``), ``solved`` which
+    of them the frame solved (``c``) and ``before`` the balls' states then. A ball that left the box
+    its pairs were found from may have met a body the broad phase never paired it with: the pairs are
+    then found afresh around where the balls are now (they replace the kept pairs, as a split step's
+    renewal does) and those new pairs are checked too."""
+    model, state = step.model, step.state
+    n = model.spheres.count
+    radius = model.spheres.radius
+    cols = frame.balls < n
+    balls = frame.balls[cols]
+    r = radius[balls]
+    if (frame.largest_move[cols] > SUBSTEP_TRAVEL * r).any():
+        return Verdict.MOVED_TOO_FAR
+    smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
+    if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
+        return Verdict.DEEPER
+    # how far each ball got from where it started (the others flew straight)
+    far = np.zeros(n + 1)
+    moved = state.body[:, X] - before[:, X]
+    far[:n] = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2 + moved[:, 2] ** 2)
+    far[balls] = np.maximum(far[balls], frame.farthest[cols])
+    kept = step.pairs.kept
+    lo, hi = frame.lo, frame.hi
+    centre = kept.centre[balls].T
+    corner = np.maximum(np.abs(lo - centre), np.abs(hi - centre))
+    escaped = (
+        (lo - r < kept.lo[balls].T).any()
+        or (hi + r > kept.hi[balls].T).any()
+        or (np.sqrt(corner[0] ** 2 + corner[1] ** 2 + corner[2] ** 2) + r > kept.reach[balls]).any()
+    )
+    if escaped:  # pairs around where the balls are now; those not solved are the ones left out
+        free, _ = free_acceleration(state.body, motion.forces)
+        pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free, motion.awake)
+        now = narrowphase.contact_points(model, state, pairs)
+        out = now.subset(~np.isin(now.keys(), c.keys()))
+        out.gap = _gap_from(out, before, model, state)
+    else:
+        out = gaps.subset(~solved)
+        b = np.where(out.kind == SPHERE_PLANE, n, out.other)
+        near = far[out.a] + far[b] >= out.gap  # only those whose balls got farther than their gap
+        out = out.subset(near)
+        start = np.minimum(out.gap, 0.0)
+        out.gap = _gap_from(out, before, model, state) - start
+    if len(out) == 0:
+        return Verdict.KEPT
+    on_plane = out.kind == SPHERE_PLANE
+    smaller = np.where(
+        on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
+    )
+    if (out.gap < -DEEP_OVERLAP * smaller).any():
+        return Verdict.LEFT_OUT
+    return Verdict.KEPT
+
+
+def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) -> np.ndarray:
+    """The gaps of the pairs ``c`` now, each ball kept on the side of a plane it started the step on
+    (``before``): a ball that crossed a plane overlaps it by its whole crossing."""
+    gap = np.empty(len(c))
+    if len(c) == 0:
+        return gap
+    x, radius = state.body[:, X], model.spheres.radius
+    on_plane = c.kind == SPHERE_PLANE
+    if on_plane.any():
+        pose = state.planes
+        s, p = c.a[on_plane], c.other[on_plane]
+        d = before[s, 0:3] - pose.center[p]
+        nrm = pose.normal[p]
+        side = np.where(d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2] < 0.0, -1.0, 1.0)
+        gap[on_plane] = collision.sphere_plane(x, radius, s, p, side, pose.center, pose.normal, pose.axis_u,
+                                               pose.axis_v, model.planes.half_size)[0]  # fmt: skip
+    if (~on_plane).any():
+        gap[~on_plane] = collision.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
+    return gap

@@ -1,0 +1,90 @@
+"""A step split at every impact, so balls meet exactly when they touch.
+
+Each interval finds the contacts, pushes overlapping balls apart, bounces the ones that arrive,
+solves the resting contacts for constant forces over the rest of the step, predicts the next impact
+and integrates to it. This is what gives e²·h apexes at 60 Hz and Newton's cradle. Each stage is
+given the restitution threshold and each contact's minimum normal speed (v_n ≥ min_normal_speed: 0
+touching) explicitly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import impacts, narrowphase, penetration, resting, rows, toi
+from ..contacts import ContactPoints
+from ..forces import ConstantPerBall, free_acceleration
+from ..pairs import KeptPairs, contact_slop
+from ..profile import Stage
+from ..settings import BROAD_PHASE_STEPS, MAX_INTERVALS
+from ..state import V, W
+from .collide import Motion, measure
+from .context import Step, integrate_interval
+
+
+def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs: KeptPairs) -> None:
+    """The step split at every impact.
+
+    ``contacts`` are the kept ``pairs`` measured now, and ``motion`` the balls' free motion now.
+    """
+    model, state, prof, dt = step.model, step.state, step.profile, step.dt
+    forces, free, ang = motion.forces, motion.lin, motion.ang
+    start, elapsed = state.time, 0.0
+    while elapsed < dt:
+        remaining, now = dt - elapsed, start + elapsed
+        first = step.intervals == 0
+        if not first:
+            contacts = measure(step, pairs)
+        touching = contacts.subset(contacts.gap < contact_slop(model))
+        with prof.stage(Stage.CONTACT_ROWS):
+            batch = rows.contact_rows(model, state, touching)
+        with prof.stage(Stage.PENETRATION):
+            penetration.remove_penetration(model, state, touching, batch)
+        min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
+        with prof.stage(Stage.IMPACTS):  # arrivals bounce in waves; then slower approaches stop
+            impacts.in_waves(model, state, touching, batch, step.restitution_threshold, min_normal_speed,
+                             step.events, now)  # fmt: skip
+            impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now)
+        if not first or len(touching):  # velocities may have changed since the step began
+            free, ang = free_acceleration(state.body, forces)
+        with prof.stage(Stage.RESTING_SOLVE):
+            push = resting.resting_forces(model, state, touching, batch, free, ang, remaining, dt,
+                                          min_normal_speed, step.warm, step.events, now)  # fmt: skip
+        lin = free if push is None else free + push.lin
+        # The first interval's free path was checked against the boxes when the pairs were taken; a
+        # path bent by a bounce or a contact force may leave them, and then the pairs are found again
+        # for the rest of this step and the next ones (they replace the kept pairs).
+        with prof.stage(Stage.PAIRS):
+            if (not first or push is not None) and pairs.escaped(model, state, lin, remaining):
+                ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
+                pairs = step.pairs.renew(model, state, remaining, ahead, lin, free, motion.awake)
+                contacts = narrowphase.contact_points(model, state, pairs)
+        if step.intervals + 1 >= MAX_INTERVALS:  # a pathological pile-up: no more splitting
+            finish_conservatively(step, motion, contacts, push, lin, remaining)
+            step.events.close_interval(1.0)
+            return
+        with prof.stage(Stage.TIME_OF_IMPACT):
+            h = min(toi.next_impact(model, state, contacts, lin, remaining), remaining)
+        integrate_interval(step, forces, push, h)
+        step.events.close_interval(h / remaining)
+        elapsed = dt if h >= remaining else elapsed + h
+
+
+def finish_conservatively(step: Step, motion: Motion, contacts: ContactPoints, push: ConstantPerBall | None,
+                          lin: np.ndarray, remaining: float) -> None:  # fmt: skip
+    """Take the rest of a step that ran out of intervals in one go, passing through nothing: every
+    ball that could reach anything in that time stops where it is (velocity and spin zero, its
+    forces balanced), and the others, which cannot, move on."""
+    model, state = step.model, step.state
+    with step.profile.stage(Stage.TIME_OF_IMPACT):
+        stop = toi.threatened(model, state, contacts, lin, remaining)
+    body = state.body
+    body[stop, V] = 0.0
+    body[stop, W] = 0.0
+    free, ang = free_acceleration(body, motion.forces)
+    held_lin = free if push is None else free + push.lin
+    held_ang = ang if push is None else ang + push.ang
+    hold = ConstantPerBall(np.where(stop[:, None], -held_lin, 0.0), np.where(stop[:, None], -held_ang, 0.0))
+    if push is not None:
+        hold = ConstantPerBall(hold.lin + push.lin, hold.ang + push.ang)
+    integrate_interval(step, motion.forces, hold, remaining)
