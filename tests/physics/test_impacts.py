@@ -164,7 +164,7 @@ def test_waves_with_the_crowded_steps_min_normal_speeds_and_jacobi_solves_pass_t
     world.spheres[0].velocity = (2 * gap / dt + 1.0, 0, 0)  # arrives within the step
     model, state = world.model, world.state
     accel, _ = free_acceleration(state.body, model.forces())
-    pairs = world._pairs.for_step(model, state, accel, dt, None)
+    pairs = world.parts.pairs.for_step(model, state, accel, dt, None)
     c = narrowphase.contact_points(model, state, pairs)
     min_normal_speed = np.where(c.gap < 1e-5, 0.0, -c.gap / dt)
     batch = rows.contact_rows(model, state, c)

@@ -176,7 +176,7 @@ def test_kept_pairs_of_still_planes_are_the_pairs_found_afresh_while_another_pla
         if k == 220:
             plank.angular_velocity = (0, 0, 0)
             paddle.velocity = (0.2, 0, 0)
-        kept = world._pairs.kept
+        kept = world.parts.pairs.kept
         if kept is not None:
             model, state = world.model, world.state
             refreshed = copy.deepcopy(kept)

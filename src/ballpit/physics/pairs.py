@@ -26,7 +26,7 @@ from .settings import (
     ESCAPE_CHUNK,
     SLOP_PER_RADIUS,
 )
-from .state import State, V, X
+from .state import State, V, X, shallow_copy
 
 
 @dataclass
@@ -146,6 +146,18 @@ class PairCache:
 
     def __init__(self) -> None:
         self.kept: KeptPairs | None = None
+
+    def checkpoint(self) -> PairCache:
+        """What ``restore`` needs to put the kept pairs back. Found pairs are replaced, never changed in
+        place (but for their sides and plane pairs, which ``for_step`` refreshes on a copy's fields
+        alike), so this shares their arrays."""
+        saved = PairCache()
+        saved.kept = None if self.kept is None else shallow_copy(self.kept)
+        return saved
+
+    def restore(self, saved: PairCache) -> None:
+        """Put back the kept pairs of ``saved`` (a ``checkpoint``; it stays usable)."""
+        self.kept = None if saved.kept is None else shallow_copy(saved.kept)
 
     def for_step(self, model: Model, state: State, accel: np.ndarray, dt: float,
                  awake: np.ndarray | None) -> KeptPairs:  # fmt: skip

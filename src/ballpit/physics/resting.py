@@ -19,7 +19,7 @@ from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows, rows_at_end
 from .settings import HOLD_PASSES, HOLD_SINK, JACOBI_FROM, WARM_START_SPAN
-from .state import State, V, W, with_static
+from .state import State, V, W, shallow_copy, with_static
 
 
 class WarmStart:
@@ -32,6 +32,15 @@ class WarmStart:
         self.apart = np.zeros(0)
         # the same three for the pairs of sleeping balls, put aside when they fell asleep (``put_to_sleep``)
         self.asleep = (np.zeros(0, np.int64), Impulses.zeros(0), np.zeros(0))
+
+    def checkpoint(self) -> WarmStart:
+        """What ``restore`` needs to put the warm start back: its arrays are replaced, never changed in
+        place, so this shares them."""
+        return shallow_copy(self)
+
+    def restore(self, saved: WarmStart) -> None:
+        """Put back the warm start ``saved`` (a ``checkpoint``; it stays usable)."""
+        self.__dict__.update(vars(saved))
 
     def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""

@@ -155,12 +155,7 @@ def after_step(model: Model, state: State, sleep: Sleep, joined: tuple[np.ndarra
         return
     idx = np.flatnonzero(falls)
     _, group = np.unique(label[idx], return_inverse=True)
-    sleep.island[idx] = sleep.islands + group
-    sleep.islands += int(group.max()) + 1
-    sleep.asleep[idx] = True
     body[idx, V] = 0.0
     body[idx, W] = 0.0
-    pose = sleep.poses()
-    pose[idx, :3] = body[idx, X]
-    pose[idx, 3:] = body[idx, Q]
+    sleep.fall_asleep(idx, group, body[idx, X], body[idx, Q])
     sleep.context = context(model, state)

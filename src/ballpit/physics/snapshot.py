@@ -4,18 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .checkpoint import Checkpoint
 from .model import Model
-from .pairs import PairCache
-from .resting import WarmStart
-from .state import State
 
 
 @dataclass(frozen=True)
 class Snapshot:
-    """Everything a World's future depends on, frozen at one moment (``World.snapshot``)."""
+    """Everything a World's future depends on, frozen at one moment (``World.snapshot``): its model and
+    a deep copy of the checkpoint of its parts."""
 
     model: Model
-    state: State
-    pairs: PairCache
-    warm: WarmStart
+    checkpoint: Checkpoint
     crowded_steps: int

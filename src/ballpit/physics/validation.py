@@ -179,18 +179,17 @@ def _unsteppable(body: np.ndarray) -> str | None:
     return f"{row} has {what} {field} ({body[row, col]})"
 
 
-def undo_non_finite_step(body: np.ndarray, before: np.ndarray) -> None:
-    """Keep the world free of NaN/inf, and of values the next step would refuse: restore the state and
-    raise if a step produced any (``step(1e6)`` let balls fall 5e12 m, and the next step then refused
-    the world's own state)."""
+def step_fault(body: np.ndarray) -> FloatingPointError | ValueError | None:
+    """What is wrong with the state ``body`` a step left, as the error to raise once the step is undone,
+    or None: a NaN/inf, or a value the next step would refuse (``step(1e6)`` let balls fall 5e12 m, and
+    the next step then refused the world's own state)."""
     if not np.isfinite(body).all():
         bad = int(np.flatnonzero(~np.isfinite(body).all(axis=1))[0])
-        body[:] = before
-        raise FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
+        return FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
     beyond = _unsteppable(body)
     if beyond is not None:
-        body[:] = before
-        raise ValueError(f"after the step sphere #{beyond}; the step was undone (take shorter steps)")
+        return ValueError(f"after the step sphere #{beyond}; the step was undone (take shorter steps)")
+    return None
 
 
 def _symmetric(limit: float) -> tuple[float, float]:

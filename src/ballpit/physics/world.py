@@ -15,6 +15,7 @@ import numpy as np
 from . import energy, moving_planes, validation
 from . import step as pipeline
 from .bodies import Plane, PlaneList, Sphere, SphereList
+from .checkpoint import Checkpoint, Parts
 from .contacts import ContactRecord
 from .forces import ForceTerm
 from .integrators import INTEGRATORS, Workspace
@@ -27,9 +28,7 @@ from .model import (
     ROLLING_FRICTION,
     Model,
 )
-from .pairs import PairCache
 from .profile import StepProfile
-from .resting import WarmStart
 from .snapshot import Snapshot
 from .state import Q, State, V, W, X
 
@@ -63,7 +62,7 @@ class World:
         substeps: int = 1,
     ) -> None:
         self.model = Model()
-        self.state = State()
+        self.parts = Parts.new()  # what a step changes: the state and the caches that change results
         self.gravity = gravity
         self.integrator = integrator
         self.linear_drag = linear_drag
@@ -73,12 +72,15 @@ class World:
         self.substeps = substeps
         self.crowded_steps = 0  # how many steps were taken as soft substeps (crowded)
         self.profile = StepProfile()  # the last step's time per stage (profile.py)
-        self._pairs = PairCache()
-        self._warm = WarmStart()
         self._workspace = Workspace()
         self._good_planes: np.ndarray | None = None  # the plane columns after the last step (validation.py)
 
     # ------------------------------------------------------------------ parameters
+    @property
+    def state(self) -> State:
+        """What a step advances: the balls' (N, 13) block, the planes' poses, the time, sleep."""
+        return self.parts.state
+
     @property
     def time(self) -> float:
         """Simulated time (s); ``step`` advances it."""
@@ -301,13 +303,13 @@ class World:
         still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
         the step's time per stage.
         """
-        step = pipeline.prepare(self.model, self.state, self._pairs, self._warm, self._workspace, dt,
-                                self._good_planes)  # fmt: skip
+        step = pipeline.prepare(self.model, self.parts, self._workspace, dt, self._good_planes)
         awake = pipeline.wake(step)
         plan = pipeline.plan(step, awake.collision, awake.motion)
-        taken = pipeline.solve(step, awake, plan)
+        checkpoint = Checkpoint.of(self.parts)  # the one undo: a soft frame's retry, a non-finite step
+        taken = pipeline.solve(step, awake, plan, checkpoint)
         pipeline.settle(step, awake)
-        record = pipeline.finish(step, plan, len(awake.collision.pairs))
+        record = pipeline.finish(step, checkpoint, plan, len(awake.collision.pairs))
         self._after_step(step, taken)
         return record
 
@@ -323,10 +325,11 @@ class World:
 
     # ------------------------------------------------------------------ snapshots
     def snapshot(self) -> Snapshot:
-        """A deep copy of everything ``step`` reads or writes: the model (balls, planes, parameters),
-        the state (ball states, time) and the caches that change results (kept pairs, warm start)."""
-        parts = copy.deepcopy((self.model, self.state, self._pairs, self._warm))
-        return Snapshot(*parts, crowded_steps=self.crowded_steps)
+        """A deep copy of everything ``step`` reads or writes: the model (balls, planes, parameters)
+        and a checkpoint of the parts a step changes (ball states, plane poses, time, sleep, and the
+        caches that change results: kept pairs, warm start)."""
+        model, checkpoint = copy.deepcopy((self.model, Checkpoint.of(self.parts)))
+        return Snapshot(model, checkpoint, crowded_steps=self.crowded_steps)
 
     def restore(self, snap: Snapshot) -> None:
         """Put the world back as it was at ``snap``; stepping on repeats the original run bit for bit.
@@ -336,15 +339,15 @@ class World:
         """
         if not isinstance(snap, Snapshot):
             raise TypeError(f"restore takes a Snapshot from World.snapshot(), got {type(snap).__name__}")
-        self.model, self.state, self._pairs, self._warm = copy.deepcopy(
-            (snap.model, snap.state, snap.pairs, snap.warm)
-        )
+        self.model, checkpoint = copy.deepcopy((snap.model, snap.checkpoint))
+        checkpoint.restore(self.parts)
         self.crowded_steps = snap.crowded_steps
         self._remember_planes()
 
     def copy(self) -> World:
         """An independent World in the same state (it steps on exactly as this one would)."""
         twin = World.__new__(World)
+        twin.parts = Parts.new()
         twin.profile = StepProfile()
         twin._workspace = Workspace()
         twin.restore(self.snapshot())

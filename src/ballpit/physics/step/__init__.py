@@ -12,7 +12,9 @@
 - ``finish``: undo a step that made anything non-finite; the time, the record and the profile.
 
 Each stage takes what it reads and returns what it makes; the world's parts it changes (state, kept
-pairs, warm start) are the ``Step``'s.
+pairs, warm start: ``checkpoint.Parts``) are the ``Step``'s. The one undo of a step is a
+``checkpoint.Checkpoint`` of them taken before the solve: a soft frame's retry and a non-finite step's
+undo both restore it.
 """
 
 from __future__ import annotations
@@ -22,13 +24,11 @@ from time import perf_counter
 import numpy as np
 
 from .. import validation
+from ..checkpoint import Checkpoint, Parts
 from ..contacts import ContactRecord, EventLog
 from ..integrators import Workspace
 from ..model import Model
-from ..pairs import PairCache
 from ..profile import StepProfile
-from ..resting import WarmStart
-from ..state import State
 from . import soft, split
 from .collide import measure
 from .context import Step
@@ -38,25 +38,26 @@ from .sleep import Awake, settle, wake
 __all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "settle", "solve", "wake"]
 
 
-def prepare(model: Model, state: State, pairs: PairCache, warm: WarmStart, workspace: Workspace,
-            dt: float, good_planes: np.ndarray | None) -> Step:  # fmt: skip
+def prepare(model: Model, parts: Parts, workspace: Workspace, dt: float,
+            good_planes: np.ndarray | None) -> Step:  # fmt: skip
     """The step's context, once it is sure the engine can step the world: ValueError naming what it
     cannot (a bad plane value is put back to ``good_planes``, the columns as the last step left them)."""
     dt = validation.number("dt", dt, positive=True)
     began = perf_counter()
+    state = parts.state
     validation.reject_unsteppable_state(state.body)
     planes = validation.reject_bad_planes(model.planes, state.planes, good_planes)
     threshold = model.restitution_threshold_for(dt)
-    return Step(model, state, pairs, warm, workspace, dt, threshold, EventLog(), StepProfile(), began, planes,
-                state.body.copy())  # fmt: skip
+    return Step(model, parts, workspace, dt, threshold, EventLog(), StepProfile(), began, planes)
 
 
-def solve(step: Step, awake: Awake, chosen: Plan) -> Strategy:
-    """Take the step as ``chosen``: a soft frame (tried with more substeps while it cannot keep its
-    promises) or, when it is split or no try held, split at every impact. Returns how it was taken."""
+def solve(step: Step, awake: Awake, chosen: Plan, checkpoint: Checkpoint) -> Strategy:
+    """Take the step as ``chosen``: a soft frame (undone to ``checkpoint`` and tried with more substeps
+    while it cannot keep its promises) or, when it is split or no try held, split at every impact.
+    Returns how it was taken."""
     collision = awake.collision
     if chosen.strategy is Strategy.SOFT:
-        if soft.frames(step, awake.motion, collision, chosen):
+        if soft.frames(step, awake.motion, collision, chosen, checkpoint):
             return Strategy.SOFT
         contacts = measure(step, collision.pairs)  # the frame took the contacts: the same again
     else:
@@ -65,10 +66,14 @@ def solve(step: Step, awake: Awake, chosen: Plan) -> Strategy:
     return Strategy.SPLIT
 
 
-def finish(step: Step, chosen: Plan, pairs: int) -> ContactRecord:
-    """Undo a step that made anything non-finite (or beyond what the engine can step) and raise;
-    else advance the time, and return the contacts resolved with the profile filled in."""
-    validation.undo_non_finite_step(step.state.body, step.before)
+def finish(step: Step, checkpoint: Checkpoint, chosen: Plan, pairs: int) -> ContactRecord:
+    """Undo a step that made anything non-finite (or beyond what the engine can step): every part back
+    to ``checkpoint``, and raise. Else advance the time, and return the contacts resolved with the
+    profile filled in."""
+    fault = validation.step_fault(step.state.body)
+    if fault is not None:
+        checkpoint.restore(step.parts)
+        raise fault
     step.state.time += step.dt
     record = step.events.record()
     prof = step.profile

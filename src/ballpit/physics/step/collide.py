@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -16,8 +16,7 @@ from ..state import State
 from .context import Step
 
 
-@dataclass(frozen=True)
-class Motion:
+class Motion(NamedTuple):
     """The balls' free motion at the step's start, and the force terms that give it.
 
     ``forces`` are the model's terms, plus one that holds the sleeping balls still while some sleep;

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import moving_planes
+from ..checkpoint import Parts
 from ..contacts import EventLog
 from ..forces import ForceTerm
 from ..integrators import Workspace, integrate
@@ -19,8 +20,8 @@ from ..state import State
 
 @dataclass
 class Step:
-    """One step's context: the world's parts the stages read and change, the step's settings, and its
-    outputs (events, profile, intervals).
+    """One step's context: the world's model, the parts the stages change (``Parts``: the state, the
+    kept pairs, the warm start), the step's settings, and its outputs (events, profile, intervals).
 
     ``intervals`` counts the intervals integrated so far in this step: the strategies read it (is this
     the first interval? is the bound MAX_INTERVALS reached?), and ``World.step`` copies it into the
@@ -28,9 +29,7 @@ class Step:
     """
 
     model: Model
-    state: State
-    pairs: PairCache
-    warm: WarmStart
+    parts: Parts
     workspace: Workspace
     dt: float
     restitution_threshold: float  # m/s, approach speed below which nothing bounces
@@ -38,9 +37,15 @@ class Step:
     profile: StepProfile
     began: float  # perf_counter() when the step began
     checked_planes: np.ndarray  # the plane columns as the step found them (validation.reject_bad_planes)
-    # the (N, 13) block as the step found it (read only): a soft frame undoes to it
-    before: np.ndarray
     intervals: int = 0
+
+    # the parts, each by its name (read often)
+    state: State = field(init=False)
+    pairs: PairCache = field(init=False)
+    warm: WarmStart = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.state, self.pairs, self.warm = self.parts.state, self.parts.pairs, self.parts.warm
 
 
 def integrate_interval(step: Step, forces: list[ForceTerm], push: ForceTerm | None, h: float) -> None:

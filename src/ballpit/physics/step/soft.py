@@ -6,12 +6,12 @@ try holds, the step is split at impacts instead (split.py, which passes through 
 
 from __future__ import annotations
 
-import copy
 from enum import Enum
 
 import numpy as np
 
 from .. import collision, moving_planes, narrowphase, softstep
+from ..checkpoint import Checkpoint
 from ..contacts import SPHERE_PLANE, ContactPoints
 from ..forces import free_acceleration
 from ..integrators import integrate
@@ -40,11 +40,11 @@ class Verdict(Enum):
     LEFT_OUT = "a pair left out overlaps deeper than DEEP_OVERLAP"
 
 
-def frames(step: Step, motion: Motion, collision: Collision, plan: Plan) -> bool:
+def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpoint: Checkpoint) -> bool:
     """The step as one soft frame of ``plan.substeps`` substeps (softstep.py) over the kept pairs of
-    ``collision`` that could meet within it; True when it was taken so (False: everything the tries
-    did is undone, and the step is to be split at impacts). The frame takes the collision's contacts
-    over (``Collision.take``).
+    ``collision`` that could meet within it; True when it was taken so (False: every try was undone to
+    ``checkpoint``, taken before the frame, and the step is to be split at impacts). The frame takes
+    the collision's contacts over (``Collision.take``).
 
     A pair could meet within the frame if its gap is less than SPECULATIVE_REACH times the distance
     its balls could cover towards each other at their own speeds, (|v_a| + |v_b| + (|a_a| + |a_b|)·dt)·dt
@@ -91,7 +91,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan) -> bool
         if fast[c.a].any() or fast[c.b].any():  # too fast for a substep: not worth a try
             continue
         last = substeps == plan.substeps << RETRIES
-        frame = _try(step, motion, gaps, solved, c, substeps, last)
+        frame = _try(step, motion, gaps, solved, c, substeps, last, checkpoint)
         if frame is not None:
             break
     else:
@@ -102,20 +102,14 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan) -> bool
 
 
 def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c: ContactPoints,
-         substeps: int, last: bool) -> softstep.Frame | None:  # fmt: skip
-    """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone)
-    when its ``verdict`` is not KEPT. The ``last`` try is kept when its only fault is a solved contact
-    that overlapped DEEPER: that is no pass through anything, and splitting a heap of overlapping balls
-    at impacts jumps them apart by positions."""
+         substeps: int, last: bool, checkpoint: Checkpoint) -> softstep.Frame | None:  # fmt: skip
+    """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone to
+    ``checkpoint``) when its ``verdict`` is not KEPT. The ``last`` try is kept when its only fault is a
+    solved contact that overlapped DEEPER: that is no pass through anything, and splitting a heap of
+    overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    # the balls as the frame found them: the step's own copy when nothing has moved them since (a frame
-    # undone puts them back to it), so a settled pile holds one copy of its states, not two
-    first = step.before is not None and step.intervals == 0
-    body_before = step.before if first else state.body.copy()
-    planes_before = copy.deepcopy(state.planes)
-    warm_before = (step.warm.keys, step.warm.forces, step.warm.apart)
-    kept_before = step.pairs.kept
+    body_before = checkpoint.saved.state.body  # the balls as the frame found them
     with step.profile.stage(Stage.SOFT_STEP):
         frame = softstep.frame(
             model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps
@@ -136,10 +130,7 @@ def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c:
         found = verdict(step, motion, gaps, solved, c, frame, body_before)
     if found is Verdict.KEPT or (last and found is Verdict.DEEPER):
         return frame
-    state.body[:] = body_before  # undo it all
-    state.planes = planes_before
-    step.warm.keys, step.warm.forces, step.warm.apart = warm_before
-    step.pairs.kept = kept_before
+    checkpoint.restore(step.parts)  # undo it all
     return None
 
 
