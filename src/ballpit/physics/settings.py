@@ -18,7 +18,7 @@ import sys
 DEFAULT_TIMESTEP = 1.0 / 240.0
 # A step is split at most this many times (intervals); past it the rest of the step is finished
 # conservatively: the balls that could meet anything stop where they are
-# (``strategies.finish_conservatively``). A pathological pile-up, not a textbook scene, gets there.
+# (``step.split.finish_conservatively``). A pathological pile-up, not a textbook scene, gets there.
 MAX_INTERVALS = 1_000
 
 # A plane turns only at this rate or faster (rad/s, about 1.5e-154: the rate whose square is the
@@ -52,7 +52,7 @@ ALL_PAIRS_UP_TO = 48
 # Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
 ESCAPE_CHUNK = 8192
 
-# --- Crowded steps (strategies.py) ------------------------------------------------------------------
+# --- Crowded steps (step/plan.py, step/soft.py) --------------------------------------------------
 
 # Default of ``World.crowd_limit``: a step in which more than this many pairs not yet touching may meet
 # is crowded (taken as a soft-step frame, softstep.py).

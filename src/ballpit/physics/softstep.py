@@ -24,7 +24,7 @@ speculative: it may close by at most s this substep, v_n ≥ −s/h. One that ov
 After the last substep one restitution pass (``restitution_pass``) bounces the contacts that closed
 faster than the threshold at the frame's start, and the impulses are kept for the next frame's warm
 start. Balls that touch no contact of the frame are left to the world's integrator (free flight keeps
-its textbook accuracy); see ``strategies.crowded_step`` for when a frame is taken this way at all and
+its textbook accuracy); see step/plan.py and step/soft.py for when a frame is taken this way at all and
 how its result is checked.
 
 Every sweep updates all contacts at once (projected Jacobi with mass splitting, ``jacobi.py``, over

@@ -1,9 +1,9 @@
 """The World: the facade over the physics. Its parameters, ``add_*``, the live views, and ``step``.
 
-What a World is lives in two objects: ``model`` (what a step reads: ball properties, planes and
-parameters; model.py) and ``state`` (what a step advances; state.py). Between steps it also keeps two
-caches that change results: the broad phase's kept pairs (pairs.py) and the warm-start forces
-(resting.py). ``step`` is a short pipeline of named stages (see ``World.step`` and strategies.py).
+What a World is lives in ``model`` (what a step reads: ball properties, planes and parameters;
+model.py) and ``parts`` (what a step changes, checkpoint.py): the ``state`` (state.py) and two caches
+that change results, the broad phase's kept pairs (pairs.py) and the warm-start forces (resting.py).
+``step`` is the pipeline of typed stages of step/, one a line.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""The strategies count a step's intervals themselves: the profile a step is timed into only measures."""
+"""The split step (step/split.py) counts a step's intervals itself: the profile a step is timed into only
+measures."""
 
 from __future__ import annotations
 
