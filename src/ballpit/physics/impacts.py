@@ -19,7 +19,7 @@ What it keeps: momentum, in every wave (impulses are equal and opposite). Energy
 of a wave arriving (v_n < 0), the wave's LCP changes the kinetic energy by
 ½·Σ P_i·(1 − e_i)·v_n,i ≤ 0 (frictionless; zero when e = 1), so no wave adds energy. An iterative solve
 that has not quite converged could still add a little, so each wave's impulses are checked and scaled
-down until it adds none (``_keep_energy``); scaling impulses keeps momentum.
+down until it adds none (``energy_guard.keep_impulses``); scaling impulses keeps momentum.
 
 What it gives: a touching cradle struck by one ball passes the impulse down the line and only the
 last ball leaves; struck by two, two leave; the Galilean cannon's top ball leaves at
@@ -34,11 +34,10 @@ At the bound: what still closes after MAX_WAVES waves is stopped, e = 0, by ``st
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 
-from . import contact_model, exact, jacobi, solver
+from . import contact_model, energy_guard, jacobi, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
@@ -91,7 +90,7 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, re
         before = _velocities(wave, v, w)
         imp = solver.solve(wave, v, w, -wave.restitution * vn[idx], Impulses.zeros(len(idx)), iterations,
                            jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
-        scale = _keep_energy(model, wave, before, v, w)
+        scale = energy_guard.keep_impulses(model, wave, before, v, w)
         keys = c.keys() if keys is None else keys
         events.add(now, c.subset(idx), keys[idx], imp.normal * scale)
         waves += 1
@@ -123,7 +122,7 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     imp = solver.solve(island, v, w, min_normal_speed[near], Impulses.zeros(len(island)),
                        model.solver_iterations, jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
                        jacobi_from=jacobi_from)  # fmt: skip
-    scale = _keep_energy(model, island, before, v, w)
+    scale = energy_guard.keep_impulses(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]
     hit = c.subset(near)
@@ -150,37 +149,7 @@ def _velocities(rows: ContactRows, v: np.ndarray, w: np.ndarray) -> tuple[np.nda
     return balls, v[balls], w[balls]
 
 
-def _keep_energy(model: Model, rows: ContactRows, before: tuple[np.ndarray, ...], v: np.ndarray,
-                 w: np.ndarray) -> float:  # fmt: skip
-    """Make sure the impulses just applied to the balls of ``rows`` added no kinetic energy, and return
-    the factor they were scaled by (1 when they added none).
-
-    With Δ the velocity change, K(s) = K₀ + s·B + ½·s²·A (B = Σ m·v₀·Δv + I·ω₀·Δω, A = Σ m·Δv² + I·Δω²).
-    If K(1) > K₀, the impulses are scaled by s = −2B/A (0 if B ≥ 0), where K(s) = K₀: equal and opposite
-    impulses stay so, and momentum is kept. A moving plane may give energy (a paddle): not checked then.
-    """
-    balls, v0, w0 = before
-    if rows.moving or len(balls) == 0:
-        return 1.0
-    dv, dw = v[balls] - v0, w[balls] - w0
-    mass = model.spheres.mass[balls]
-    inertia = 1.0 / model.spheres.inv_inertia[balls]
-
-    def dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return x[:, 0] * y[:, 0] + x[:, 1] * y[:, 1] + x[:, 2] * y[:, 2]
-
-    # exact sums (math.fsum): the same bits on every CPU
-    b = math.fsum(mass * dot(v0, dv)) + math.fsum(inertia * dot(w0, dw))
-    a = math.fsum(mass * dot(dv, dv)) + math.fsum(inertia * dot(dw, dw))
-    if b + 0.5 * a <= 0.0 or a == 0.0:
-        return 1.0
-    s = max(0.0, -2.0 * b / a)
-    v[balls] = v0 + s * dv
-    w[balls] = w0 + s * dw
-    return s
-
-
-def waves_from(rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: np.ndarray,
+def waves_from(model: Model, rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: np.ndarray,
                restitution_threshold: float, pressed: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
     """The module's rule for a frame solved as a whole (the soft step's restitution, softstep.py): the
     waves are run on the normal speeds the contacts had at the frame's start, ``vn_start``, over the
@@ -192,7 +161,7 @@ def waves_from(rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: n
     way whatever velocities they start from, so this is the rule applied to the frame's start, without
     its start velocities: its arriving contacts (closing faster than the threshold) are solved together
     to v_n' ≥ −e·v_n, then those the wave set closing, at most MAX_WAVES times; no wave adds energy
-    (ΔK = Σ P·(v_n + ½·Δv_n) ≤ 0, checked and scaled as ``_keep_energy`` does).
+    (ΔK = Σ P·(v_n + ½·Δv_n) ≤ 0, checked and scaled by ``energy_guard.wave_scale``).
     """
     copy = np.array(v[:3])
     after = np.array(vn_start)
@@ -224,10 +193,9 @@ def waves_from(rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: n
         impulse, after_vn = _wave_sweeps(wave, m, inv3, copy, target)
         after_vn += offset[idx]
         # ΔK of the wave's normal impulses: Σ P·v_n + ½·Σ P·Δv_n (spheres: they do not turn the balls)
-        gain_b = exact.total(impulse * vn[idx])
-        gain_a = exact.total(impulse * (after_vn - vn[idx]))
-        if not rows.moving and gain_b + 0.5 * gain_a > 0.0 and gain_a > 0.0:
-            copy = before + max(0.0, -2.0 * gain_b / gain_a) * (copy - before)
+        scale = energy_guard.wave_scale(model, rows.moving, impulse, vn[idx], after_vn)
+        if scale is not None:
+            copy = before + scale * (copy - before)
         # only the contacts of the balls the wave moved change speed
         moved = np.zeros(m, bool)
         moved[wave[0]] = True

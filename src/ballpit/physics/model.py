@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import exact
+from .energy_guard import EnergyGuards
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
 from .settings import CROWD_LIMIT, SLOWEST_TURN, SOLVER_ITERATIONS
@@ -78,6 +79,7 @@ class Model:
         self.crowd_limit: float = CROWD_LIMIT
         self.sleep = False  # whether still islands fall asleep (sleeping.py)
         self.substeps = 1  # soft substeps of a crowded step (softstep.py)
+        self.guards = EnergyGuards()  # which energy guards are on (energy_guard.py): all, but in tests
 
     def append_spheres(self, n: int, *, radius, mass, restitution, friction, rolling_friction,
                        hollow) -> slice:  # fmt: skip

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import contact_model, exact, jacobi
+from . import contact_model, energy_guard, exact, jacobi
 from .contacts import ContactPoints
 from .model import Model
 from .rows import ContactRows
 from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, OVERLAP_TOLERANCE, PENETRATION_SWEEPS
-from .state import State, V, X, with_static
+from .state import State, X, with_static
 
 
 def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
@@ -33,7 +33,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
     else:
         _separate_by_colour(c, rows, pos)
     new = keep_sides_of_planes(model, state, x, pos[:-1], deeper=True)
-    pay_for_lift(model, state, x, new, partly=True)
+    energy_guard.pay_for_lift(model, state, x, new, partly=True)
     x[:] = new
 
 
@@ -50,35 +50,6 @@ def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) ->
             pos[a] += depth * part_a[idx, None]
             pos[b] += depth * part_b[idx, None]
         pos[-1] = 0.0
-
-
-def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, partly: bool = False) -> None:
-    """Take the potential energy a separation adds, ΔU = −Σ m·g·Δx, out of the moved balls' kinetic
-    energy (their velocities scaled by √(1 − ΔU/K)), so removing overlaps never adds energy.
-
-    Moving positions alone lifts balls against gravity: in a closed elastic box that once made the
-    total energy creep up by 1e-5 every few seconds (nphysics #69 and haxball #2157 report the same).
-    A lowering separation is left alone: energy lost there stays lost.
-
-    When the moved balls' kinetic energy cannot pay for the whole lift, ``partly`` moves them only the
-    part of the way it pays for, K/ΔU (``new`` changes in place), and stops them: the split step then
-    leaves a resting overlap the soft step held (within its slop) as it is, instead of lifting a ball
-    at rest out of it for nothing (pile.toml gained up to 1.7e-5 J a step that way, #24). Without it
-    the balls are moved all the way (the soft step's push-outs, and planes that win).
-    """
-    moved = np.flatnonzero((new != old).any(axis=1))
-    if moved.size == 0:
-        return
-    mass = model.spheres.mass[moved]
-    lift = -exact.total(mass * exact.dot(new[moved] - old[moved], model.gravity))
-    if lift <= 0.0:
-        return
-    v = state.body[moved, V]
-    kinetic = 0.5 * exact.total(mass * exact.dot(v, v))
-    if partly and kinetic < lift:
-        new[moved] = old[moved] + (kinetic / lift) * (new[moved] - old[moved])
-    scale = np.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
-    state.body[moved, V] = v * scale
 
 
 def keep_sides_of_planes(model: Model, state: State, old: np.ndarray, new: np.ndarray,

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import impacts, jacobi, penetration, quaternion
+from . import energy_guard, impacts, jacobi, penetration, quaternion
 from .contact_model import Impulses, dot
 from .contacts import ContactPoints
 from .forces import ConstantPerBall, ForceTerm, constant_acceleration
@@ -181,7 +181,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
         np.minimum(lo, x[:, live], out=lo)
         np.maximum(hi, x[:, live], out=hi)
 
-    added = restitution_pass(rows, k, vw, normal, vn_start, threshold, total > 0.0)
+    added = restitution_pass(model, rows, k, vw, normal, vn_start, threshold, total > 0.0)
     total += added
     # a level contact (normal within LEVEL of square to gravity: it holds up no weight) that the impacts
     # changed keeps no more warm start than it came with: its last substep's impulse was the impact's
@@ -223,7 +223,7 @@ def frame(model, state, c: ContactPoints, forces: list[ForceTerm], dt: float, th
                         rows.inv_mass_b[part], pos, SEPARATE_SWEEPS)  # fmt: skip
         del normals
         new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
-        penetration.pay_for_lift(model, state, body[:, X], new)
+        energy_guard.pay_for_lift(model, state, body[:, X], new)
         moved = new - body[:, X]
         ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
         d = ma - mb
@@ -265,12 +265,12 @@ def _out_of_planes(model, state, c: ContactPoints, rows: ContactRows, least: np.
     lift = np.zeros((len(body), 3))
     np.add.at(lift, a, deficit[:, None] * nrm)
     new += lift
-    penetration.pay_for_lift(model, state, body[:, X], new)
+    energy_guard.pay_for_lift(model, state, body[:, X], new)
     body[:, X] = new
     least[on] = np.minimum(least[on], s + deficit)
 
 
-def restitution_pass(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray,
+def restitution_pass(model, rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray,
                      vn_start: np.ndarray, threshold: float, pressed: np.ndarray) -> np.ndarray:  # fmt: skip
     """The frame's impacts, by the rule of the split step (impacts in waves, ``impacts.waves_from``):
     when a contact that pushed during the frame (``pressed``) closed faster than ``threshold`` at its
@@ -284,7 +284,7 @@ def restitution_pass(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, norm
     added = np.zeros(len(normal))
     if not (pressed & (vn_start < -threshold) & (rows.restitution > 0.0)).any():
         return added
-    after, struck = impacts.waves_from(rows, k, vw, vn_start, threshold, pressed)
+    after, struck = impacts.waves_from(model, rows, k, vw, vn_start, threshold, pressed)
     # the pressed contacts beside a struck one take part too: a ball the waves left still holds on them
     touched = np.zeros(k.m, bool)
     touched[k.ends[: k.k][struck]] = True
@@ -363,57 +363,3 @@ def _turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
     quaternion.derivative(q, w.T, dq)
     q += h * dq
     quaternion.normalize(q, out=q)
-
-
-def hold_energy(model, state, before: np.ndarray, balls: np.ndarray) -> None:
-    """Take any energy the frame gained out of the balls ``balls`` it moved: with no moving plane doing
-    work, a frame may lose energy (inelastic bounces, friction) but never gain it, yet pushing overlaps
-    apart lifts balls and a Jacobi restitution pass can overshoot. Their velocities relative to their
-    centre of mass (and their spins) are scaled by the one factor that gives back the energy they had
-    at ``before``, E = ½·m·v² + ½·I·ω² − m·g·x: momentum is kept, and so is every direction of motion.
-
-    When the springs lifted the balls by more than all their motion relative to the centre of mass
-    can pay (a settled pile whose load shifted: the overlaps it sank into spring back), that motion
-    is stopped and the balls that rose are taken back towards where they started, each by the one
-    fraction λ of its rise that leaves the energy they had (the potential −m·g·x is linear in x, so
-    λ is exact); the balls that sank keep their places. The overlaps left are those of the frame's
-    start or less, and the next frames push them apart as far as energy allows."""
-    sleeping = state.sleep.asleep
-    if len(sleeping) == len(state.body) and sleeping.any():
-        balls = balls[~sleeping[balls]]
-    if balls.size == 0:
-        return
-    sph = model.spheres
-    mass, inertia = sph.mass[balls], 1.0 / sph.inv_inertia[balls]
-    g = model.gravity
-    old, new = before[balls], state.body[balls]
-
-    def energy(rows: np.ndarray) -> tuple[float, float]:
-        v, w, x = rows[:, V], rows[:, W], rows[:, X]
-        kinetic = 0.5 * (mass * dot(v.T, v.T) + inertia * dot(w.T, w.T))
-        potential = -mass * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
-        return float(np.cumsum(kinetic)[-1]), float(np.cumsum(potential)[-1])
-
-    k0, u0 = energy(old)
-    k1, u1 = energy(new)
-    if k1 + u1 <= k0 + u0:
-        return
-    total = float(np.cumsum(mass)[-1])
-    v, w = new[:, V], new[:, W]
-    momentum = mass[:, None] * v
-    v_cm = np.array([float(np.cumsum(momentum[:, i])[-1]) for i in range(3)]) / total
-    k_cm = 0.5 * total * float(v_cm[0] ** 2 + v_cm[1] ** 2 + v_cm[2] ** 2)
-    k_rel = k1 - k_cm
-    room = k0 + u0 - u1 - k_cm
-    scale = math.sqrt(room / k_rel) if room > 0.0 and k_rel > 0.0 else 0.0
-    state.body[balls, V] = v_cm + scale * (v - v_cm)
-    state.body[balls, W] = scale * w
-    if room < 0.0:  # the rise is more than the motion can pay: take the rising balls part way back
-        x0, x1 = old[:, X], new[:, X]
-        rise = -mass * (
-            (x1[:, 0] - x0[:, 0]) * g[0] + (x1[:, 1] - x0[:, 1]) * g[1] + (x1[:, 2] - x0[:, 2]) * g[2]
-        )
-        up = rise > 0.0
-        lifted = float(np.cumsum(np.where(up, rise, 0.0))[-1])
-        fraction = min(max(1.0 + room / lifted, 0.0), 1.0) if lifted > 0.0 else 1.0
-        state.body[balls[up], 0:3] = x0[up] + fraction * (x1[up] - x0[up])

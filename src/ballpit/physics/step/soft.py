@@ -10,7 +10,7 @@ from enum import Enum
 
 import numpy as np
 
-from .. import collision, moving_planes, narrowphase, softstep
+from .. import collision, energy_guard, moving_planes, narrowphase, softstep
 from ..checkpoint import Checkpoint
 from ..contacts import SPHERE_PLANE, ContactPoints
 from ..forces import free_acceleration
@@ -117,8 +117,7 @@ def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c:
         balls = frame.balls[frame.balls < n]
         others = np.ones(n, bool)
         others[balls] = False
-        if not model.moving_planes():  # then nothing does work on the balls but gravity
-            softstep.hold_energy(model, state, body_before, balls)
+        energy_guard.hold_frame(model, state, body_before, balls)
     if others.any():  # balls touching nothing this frame fly on the world's integrator
         with step.profile.stage(Stage.INTEGRATE):
             rows = state.body[others]

@@ -1,0 +1,98 @@
+"""The energy guards (energy_guard.py): each keeps one kind of contact stage from adding mechanical
+energy. Each is shown against a case where, switched off, the energy rises, and, on, it does not."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import ballpit
+from ballpit.physics import impacts, narrowphase, rows
+from ballpit.physics.contacts import EventLog
+from ballpit.physics.energy_guard import EnergyGuards
+from ballpit.physics.forces import free_acceleration
+
+G = 9.81
+
+
+def energy(world: ballpit.World) -> float:
+    return world.kinetic_energy() + world.potential_energy()
+
+
+def momentum(world: ballpit.World) -> np.ndarray:
+    return (world.spheres.masses[:, None] * world.spheres.velocities).sum(axis=0)
+
+
+def struck_cluster(guards: EnergyGuards) -> tuple[ballpit.World, float, np.ndarray]:
+    """A dozen balls nearly on top of each other (seed 171 of a search over random clusters), rough
+    (μ 0.15) and nearly elastic (e 0.99), bounced in waves as the split step does; returns the world,
+    its kinetic energy and its momentum before the bounce."""
+    rng = np.random.default_rng(171)
+    world = ballpit.World(gravity=(0, 0, 0))
+    x, v = rng.normal(size=(12, 3)) * 0.15, rng.normal(size=(12, 3))
+    world.add_spheres(x, radius=0.1, velocity=v, friction=rng.uniform(0, 1), restitution=rng.uniform(0.3, 1))
+    world.model.guards = guards
+    model, state = world.model, world.state
+    accel, _ = free_acceleration(state.body, model.forces())
+    pairs = world.parts.pairs.for_step(model, state, accel, 1 / 240, None)
+    c = narrowphase.contact_points(model, state, pairs)
+    touching = c.subset(c.gap < 1e-5)
+    kinetic, p = world.kinetic_energy(), momentum(world)
+    batch = rows.contact_rows(model, state, touching)
+    impacts.in_waves(model, state, touching, batch, 0.0, np.zeros(len(touching)), EventLog(), 0.0)
+    return world, kinetic, p
+
+
+def test_the_impulse_guard_keeps_a_wave_of_rough_impacts_from_adding_kinetic_energy():
+    # Newton's law with Coulomb friction, solved colour by colour to 50 sweeps, is not exactly the
+    # frictionless LCP that never adds energy: here the waves add 38 mJ without the guard.
+    off, kinetic, p = struck_cluster(EnergyGuards(impulses=False))
+    assert off.kinetic_energy() > kinetic + 0.01
+    on, kinetic, p = struck_cluster(EnergyGuards())
+    assert on.kinetic_energy() <= kinetic
+    assert momentum(on) == pytest.approx(p, abs=1e-12)  # the impulses were scaled, not dropped
+
+
+def sunk_sliding_ball(guards: EnergyGuards) -> ballpit.World:
+    """A ball sunk 5 mm into a frictionless floor, sliding at 1 m/s; steps split at impacts."""
+    world = ballpit.World()
+    world.crowd_limit = math.inf
+    world.add_plane(friction=0.0)
+    world.add_sphere(position=(0, 0.1 - 0.005, 0), radius=0.1, velocity=(1, 0, 0), friction=0.0)
+    world.model.guards = guards
+    return world
+
+
+def test_the_lift_guard_pays_for_lifting_a_ball_out_of_the_floor_with_its_speed():
+    # Moving the ball out lifts it 5 mm: m·g·5 mm = 49 mJ, paid out of its ½·m·v² = 0.5 J.
+    for guards, gain in ((EnergyGuards(lift=False), 1.0 * G * 0.005), (EnergyGuards(), 0.0)):
+        world = sunk_sliding_ball(guards)
+        before = energy(world)
+        world.step(1 / 240)
+        assert world.spheres[0].position[1] == pytest.approx(0.1, abs=1e-12)  # moved out either way
+        assert energy(world) - before == pytest.approx(gain, abs=1e-12)
+    assert world.spheres[0].velocity[0] == pytest.approx(math.sqrt(1.0 - 2 * G * 0.005), rel=1e-12)
+
+
+def sunk_row(guards: EnergyGuards) -> ballpit.World:
+    """Five balls in a row on a floor, each sunk 20 % of a radius into the next: soft frames push them
+    apart sideways."""
+    world = ballpit.World(substeps=4)
+    world.add_plane(friction=0.5)
+    world.add_spheres([(0.16 * k, 0.1, 0) for k in range(5)], radius=0.1)
+    world.model.guards = guards
+    return world
+
+
+def test_the_frame_guard_keeps_soft_frames_pushing_a_sunk_row_apart_from_gaining_energy():
+    off, on = sunk_row(EnergyGuards(frame=False)), sunk_row(EnergyGuards())
+    start = energy(on)
+    for _ in range(3):
+        off.step(1 / 60)
+        on.step(1 / 60)
+        assert on.crowded_steps == off.crowded_steps  # soft frames, both
+        assert energy(on) <= start + 1e-12
+    assert on.crowded_steps == 3
+    assert energy(off) > start + 0.1  # the springs' push, half a joule and more, kept without the guard
