@@ -72,6 +72,17 @@ class ConstantPerBall:
         return lin + self.lin, ang + self.ang
 
 
+def forces_of(forces: list[ForceTerm], idx: np.ndarray, n_balls: int) -> list[ForceTerm]:
+    """The force terms for the balls ``idx`` alone: per-ball constant terms (a sleeping ball's hold)
+    cut down to their rows."""
+    terms: list[ForceTerm] = []
+    for term in forces:
+        if isinstance(term, ConstantPerBall) and len(term.lin) == n_balls:
+            term = ConstantPerBall(term.lin[idx], term.ang[idx])
+        terms.append(term)
+    return terms
+
+
 def free_acceleration(body: np.ndarray, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
     """Linear and angular acceleration of each ball from the force terms alone, at state ``body``."""
     constant = constant_acceleration(forces)

@@ -22,7 +22,17 @@ class Stage:
     PENETRATION = "penetration"
     IMPACTS = "impacts"
     RESTING_SOLVE = "resting solve"
-    SOFT_STEP = "soft step"
+    # a soft frame's stages (softstep.py, separate.py; Box2D's solver stages) and its energy guard
+    PREPARE_CONTACTS = "prepare contacts"
+    INTEGRATE_VELOCITIES = "integrate velocities"
+    WARM_START = "warm start"
+    SOFT_SOLVE = "soft solve"
+    INTEGRATE_POSITIONS = "integrate positions"
+    RELAX = "relax"
+    RESTITUTION = "restitution"
+    STORE_IMPULSES = "store impulses"
+    SEPARATE = "separate"
+    ENERGY_GUARD = "energy guard"
     TIME_OF_IMPACT = "time of impact"
     INTEGRATE = "integrate"
 
@@ -36,7 +46,16 @@ STAGES = (
     Stage.PENETRATION,
     Stage.IMPACTS,
     Stage.RESTING_SOLVE,
-    Stage.SOFT_STEP,
+    Stage.PREPARE_CONTACTS,
+    Stage.INTEGRATE_VELOCITIES,
+    Stage.WARM_START,
+    Stage.SOFT_SOLVE,
+    Stage.INTEGRATE_POSITIONS,
+    Stage.RELAX,
+    Stage.RESTITUTION,
+    Stage.STORE_IMPULSES,
+    Stage.SEPARATE,
+    Stage.ENERGY_GUARD,
     Stage.TIME_OF_IMPACT,
     Stage.INTEGRATE,
     Stage.SLEEP,

@@ -13,7 +13,7 @@ import numpy as np
 from .. import collision, energy_guard, moving_planes, narrowphase, softstep
 from ..checkpoint import Checkpoint
 from ..contacts import SPHERE_PLANE, ContactPoints
-from ..forces import free_acceleration
+from ..forces import forces_of, free_acceleration
 from ..integrators import integrate
 from ..model import Model
 from ..profile import Stage
@@ -110,18 +110,18 @@ def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c:
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
     body_before = checkpoint.saved.state.body  # the balls as the frame found them
-    with step.profile.stage(Stage.SOFT_STEP):
-        frame = softstep.frame(
-            model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps
-        )
-        balls = frame.balls[frame.balls < n]
-        others = np.ones(n, bool)
-        others[balls] = False
+    frame = softstep.frame(
+        model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps, step.profile
+    )
+    balls = frame.balls[frame.balls < n]
+    others = np.ones(n, bool)
+    others[balls] = False
+    with step.profile.stage(Stage.ENERGY_GUARD):
         energy_guard.hold_frame(model, state, body_before, balls)
     if others.any():  # balls touching nothing this frame fly on the world's integrator
         with step.profile.stage(Stage.INTEGRATE):
             rows = state.body[others]
-            terms = softstep.compact_terms(motion.forces, np.flatnonzero(others), n)
+            terms = forces_of(motion.forces, np.flatnonzero(others), n)
             integrate(model.integrator, rows, terms, dt, step.workspace)
             state.body[others] = rows
     moving_planes.advance(model, state, dt)
