@@ -29,6 +29,7 @@ TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
 SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
+DOUBLE_CLICK_SECONDS = 0.35  # a second left press within this time, at the same place, is a double-click
 
 
 def default_scene() -> Path:
@@ -69,9 +70,12 @@ class Viewer:
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
         from .interaction import Interaction
+        from .orbit import Orbit
+        from .panel import Panel
         from .renderer import Renderer
         from .screen import ScreenOverlay
         from .stepper import PhysicsThread
+        from .watch import Traces
 
         if world is None:
             from ballpit.scene import read_scene
@@ -97,7 +101,13 @@ class Viewer:
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
-        self.physics = PhysicsThread(self.sim, needs=self._needs)
+        self.traces = Traces()
+        self.sim.after_step.append(lambda: self.traces.sample(self.sim))
+        self.sim.after_reset.append(lambda: self.traces.follow(None))
+        self.orbit = Orbit()
+        self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
+        self.panel = Panel(self)
+        self._last_press = (0.0, 0.0, 0.0)  # (time, x, y) of the last left press: a double-click orbits
         self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
@@ -141,7 +151,7 @@ class Viewer:
         )
         return pyglet.window.Window(
             width=size[0], height=size[1], caption="ballpit", resizable=True, vsync=True,
-            visible=visible, config=config,
+            visible=visible, config=config, file_drops=True,
         )  # fmt: skip
 
     def set_quality(self, option: str) -> None:
@@ -166,6 +176,57 @@ class Viewer:
         f, screen = self.flags, getattr(self, "screen", None)
         return Needs(f.contacts, f.velocities, f.trails, energy=screen is not None and screen.show_plot)
 
+    def _watch(self, sim: Simulation) -> object:
+        """The panel's copy of the run (physics side, at each hand-over): settings, the selection,
+        and the traces while the plots are open."""
+        from .watch import watch
+
+        it = self.interaction
+        self.traces.follow(it.selected_ball)
+        selected = None
+        if it.selected_ball is not None:
+            selected = ("ball", it.selected_ball)
+        elif it.selected_plane is not None:
+            selected = ("plane", it.selected_plane)
+        return watch(sim, selected, self.traces if self.panel_plots else None)
+
+    @property
+    def panel_plots(self) -> bool:
+        panel = getattr(self, "panel", None)
+        return panel is not None and panel.wants_plots
+
+    def select(self, ball: int | None) -> None:
+        """Select ``ball`` in the inspector (None: nothing)."""
+
+        def choose(sim: Simulation) -> None:
+            self.interaction.deselect()
+            self.interaction.selected_ball = ball
+
+        self.command(choose)
+
+    def scene_opened(self) -> None:
+        """Another scene was opened: the camera goes to its view."""
+        look = self.sim.appearance
+        self.orbit.stop()
+        self.camera.look_from(look.camera_position, look.camera_look_at)
+        self.window.set_caption(title(look.name, self.fps))
+
+    def start_orbit(self, target: object = None, ball: int | None = None) -> None:
+        """Orbit ``target`` (by default what the view's centre shows, else the scene's look-at point)."""
+        if target is not None:
+            self.orbit.start(self.camera, target, ball)
+            return
+        from .picking import pick, pointer_ray
+
+        w, h = self.window.width, self.window.height
+        ray = pointer_ray(self.camera, self.panel.width + (w - self.panel.width) / 2, h / 2, w, h)  # the view's centre
+
+        def aim(sim: Simulation) -> object:
+            hit = pick(ray, sim.world)
+            return hit.point if hit is not None else sim.appearance.camera_look_at
+
+        self.command(aim, lambda point: self.orbit.start(self.camera, point))
+
     @property
     def shown(self) -> Shown:
         """The latest state the physics handed over."""
@@ -184,64 +245,17 @@ class Viewer:
             self.physics.show_again()
 
     def _perform(self, action: Action) -> None:
-        do = self.command
-        if action is Action.START:
-            do(lambda sim: sim.start())
-        elif action is Action.PAUSE:
-            do(lambda sim: sim.toggle_pause())
-        elif action is Action.STEP:
-            do(lambda sim: sim.step_once())
-        elif action is Action.RESET:
-            do(lambda sim: sim.reset())
-        elif action is Action.RELOAD:
-            self.reload()
-        elif action in controls.INTEGRATOR_ACTIONS:
-            name = controls.INTEGRATOR_ACTIONS[action]
-            do(lambda sim: sim.set_integrator(name))
-        elif action is Action.FASTER:
-            do(lambda sim: sim.faster())
-        elif action is Action.SLOWER:
-            do(lambda sim: sim.slower())
-        elif action is Action.CAPTURE_MOUSE:
-            self.capture_mouse(not self.mouse_captured)
-        elif action is Action.ESCAPE:
-            self.escape()
-        elif action is Action.CONTACTS:
-            self.flags.contacts = not self.flags.contacts
-        elif action is Action.VELOCITIES:
-            self.flags.velocities = not self.flags.velocities
-        elif action is Action.TRAILS:
-            self.flags.trails = not self.flags.trails
-        elif action is Action.HUD:
-            self.hud.show_hud = not self.hud.show_hud
-        elif action is Action.PROFILE:
-            self.hud.page = "stats" if self.hud.page == "profile" else "profile"
-            self.hud.show_hud = True
-        elif action is Action.HELP:
-            self.hud.show_help = not self.hud.show_help
-        elif action is Action.SCREENSHOT:
-            self.screenshot_requested = True
-        elif action is Action.QUALITY:
-            from .quality import other
+        from .actions import perform
 
-            self.set_quality(other(self.quality).name)
-            self.hud.flash(f"quality {self.quality.describe()}", time.perf_counter())
-        elif action in controls.TIME_ACTIONS:
-            do(controls.TIME_ACTIONS[action])
-        elif action is Action.ENERGY_PLOT:
-            self.screen.show_plot = not self.screen.show_plot
-        elif action is Action.SHOOT:
-            camera = copy.deepcopy(self.camera)
-            do(lambda sim: self.interaction.shoot(camera))
-        elif action is Action.SHOT_SPEED:
-            self.hud.flash(f"shot speed {self.interaction.next_shot_speed():g} m/s", time.perf_counter())
-        elif action is Action.HOME:
-            look = self.shown.appearance
-            self.camera.look_from(look.camera_position, look.camera_look_at)
-        elif action is Action.SAVE:
-            self.save_scene()
+        perform(self, action)
         self._hud_at = 0.0  # refresh the HUD on the next frame
         self.physics.refresh_hud()
+
+    def home(self) -> None:
+        """Home: the camera back to the scene's view (the free-fly camera)."""
+        look = self.shown.appearance
+        self.camera.look_from(look.camera_position, look.camera_look_at)
+        self.orbit.stop()
 
     def escape(self) -> None:
         """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
@@ -272,14 +286,17 @@ class Viewer:
         last good scene and the HUD shows the error."""
         self.command(lambda sim: (sim.reload(), sim.error)[1], self.hud.set_error)
 
-    def save_scene(self) -> None:
-        """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
+    def save_scene(self, path: Path | None = None) -> None:
+        """Ctrl+S: write the scene as it stands to a new file beside the original (or to ``path``, the
+        panel's Save as); the HUD says where."""
         camera = copy.deepcopy(self.camera)
 
         def save(sim: Simulation) -> Path | OSError:
-            from .save import save_scene
+            from .save import save_scene, save_scene_as
 
             try:
+                if path is not None:
+                    return save_scene_as(sim, camera, path, self.interaction.own_motion())
                 return save_scene(sim, camera, self.interaction.own_motion())
             except OSError as exc:
                 return exc
@@ -331,6 +348,9 @@ class Viewer:
     def on_key_press(self, symbol: int, modifiers: int) -> bool:
         from pyglet.window import key
 
+        self.panel.backend.key(symbol, True)
+        if self.panel.wants_keyboard:  # typing into a field of the panel
+            return True
         name = key.symbol_string(symbol)
         ctrl = bool(modifiers & key.MOD_ACCEL)
         if not (ctrl and name in controls.FLY_KEYS):  # Ctrl+S saves; it does not fly back
@@ -343,6 +363,9 @@ class Viewer:
         return True  # handled: stops pyglet's default "Esc closes the window"
 
     def on_text(self, text: str) -> bool:
+        self.panel.backend.text(text)
+        if self.panel.wants_keyboard:
+            return True
         action = controls.action_for_text(text)
         if action is not None:
             self.perform(action)
@@ -351,15 +374,24 @@ class Viewer:
     def on_key_release(self, symbol: int, modifiers: int) -> bool:
         from pyglet.window import key
 
+        self.panel.backend.key(symbol, False)
         self.held.discard(key.symbol_string(symbol))
         return True
 
     def on_deactivate(self) -> None:
         self.held.clear()
 
+    def on_file_drop(self, x: int, y: int, paths: list[str]) -> None:
+        """A file dropped on the window: a scene opens (one that is not valid keeps the current one)."""
+        if paths:
+            self.panel.open_scene(Path(paths[0]))
+
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        self.panel.backend.mouse_button(x, y, button, True)
+        if self.panel.covers(x, y):
+            return
         if button == mouse.LEFT and self.screen.press(x, y):  # on the timeline bar: scrub
             return
         from .picking import pointer_ray
@@ -367,15 +399,35 @@ class Viewer:
         if button == mouse.LEFT and not self.mouse_captured:
             ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
             facing = self.camera.forward
+            now = time.perf_counter()
+            t, px, py = self._last_press
+            double = now - t < DOUBLE_CLICK_SECONDS and abs(x - px) + abs(y - py) < 6
+            self._last_press = (0.0 if double else now, x, y)
+            if self.panel.adding_ball:
+                self.add_ball_at(ray)
+                return
 
             def press(sim: Simulation) -> None:
                 sim.message = self.interaction.press(ray, x, y, facing) or sim.message
 
-            self.command(press)
+            self.command(press, (lambda _: self._orbit_clicked()) if double else None)
+
+    def add_ball_at(self, ray: object) -> None:
+        """The inspector's "add a ball where I click": a ball resting on the plane clicked."""
+        self.panel.edits.add_ball(ray, lambda index: self.select(index))
+
+    def _orbit_clicked(self) -> None:
+        """A double-click on a ball: orbit it (and follow it, if the View section asks)."""
+        ball = self.interaction.selected_ball
+        if ball is None or ball >= self.shown.ball_count:
+            return
+        self.command(lambda sim: self.interaction.release())
+        self.start_orbit(self.shown.positions[ball], ball)
 
     def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        self.panel.backend.mouse_button(x, y, button, False)
         self.screen.release()
         if button == mouse.LEFT:
             self.command(lambda sim: self.interaction.release())
@@ -383,21 +435,39 @@ class Viewer:
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         from pyglet.window import mouse
 
+        self.panel.backend.mouse_motion(x, y)
+        if self.panel.backend.wants_mouse:  # a drag that started on the panel
+            return
         if buttons & mouse.LEFT and self.screen.drag(x, y):
             return
         if buttons & mouse.LEFT:
             self.interaction.move(x, y)
+            if self.orbit.active and self.interaction.held_ball is None:
+                self.orbit.turn(self.camera, dx, dy)
+        if buttons & mouse.MIDDLE and self.orbit.active:
+            self.orbit.pan(self.camera, dx, dy, self.window.height)
         if buttons & mouse.RIGHT or self.mouse_captured:
-            self.camera.look(dx, dy)
+            if self.orbit.active:
+                self.orbit.turn(self.camera, dx, dy)
+            else:
+                self.camera.look(dx, dy)
 
     def on_mouse_motion(self, x: int, y: int, dx: int, dy: int) -> None:
+        self.panel.backend.mouse_motion(x, y)
         if self.mouse_captured:
             self.camera.look(dx, dy)
 
     def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
-        self.camera.speed = controls.scrolled_fly_speed(self.camera.speed, scroll_y)
+        self.panel.backend.scroll(x, y, scroll_x, scroll_y)
+        if self.panel.covers(x, y):
+            return
+        if self.orbit.active:
+            self.orbit.zoom(self.camera, scroll_y)
+        else:
+            self.camera.speed = controls.scrolled_fly_speed(self.camera.speed, scroll_y)
 
     def on_resize(self, width: int, height: int) -> None:
+        self.panel.backend.resize()
         self.hud.layout()  # pyglet's own handler (viewport, HUD projection) runs after this one
 
     def on_close(self) -> None:
@@ -415,14 +485,19 @@ class Viewer:
         now = time.perf_counter()
         elapsed = now - self._last_frame if dt is None else dt
         self._last_frame = now
-        self.camera.fly(
-            controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
-        )
+        if self.orbit.active:
+            if self.orbit.follow is not None and self.orbit.follow < self.shown.ball_count:
+                self.orbit.carry(self.camera, self.shown.positions[self.orbit.follow])
+        else:
+            self.camera.fly(
+                controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
+            )
         self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
             self._watch_at = now + WATCH_INTERVAL
             # reads the file's signature and the error alone: the steps taken ahead stay (stepper.py)
             self.physics.submit(lambda sim: (sim.file_changed(), sim.error), self._watched, rewind=False)
+        self.camera.inset = self.panel.width / max(self.window.width, 1)
         started = time.perf_counter()
         if dt is None:
             self.physics.run_free()
@@ -448,6 +523,7 @@ class Viewer:
         view.finish(width, height)
         self._draw_hud(now, shown)
         self.screen.draw_labels()
+        self.panel.draw(shown)
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -460,7 +536,7 @@ class Viewer:
         if self.interaction.held_ball is not None:
             return None
         c = self.camera
-        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, width, height,
+        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset, width, height,
                 self.flags.contacts, self.flags.velocities, self.flags.trails, self.screen.show_plot,
                 self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
@@ -493,8 +569,9 @@ class Viewer:
     def _draw_hud(self, now: float, shown: Shown) -> None:
         from .hud import hud_lines, profile_lines
 
-        if self.hud.bottom != self.screen.bottom_clearance():
+        if self.hud.bottom != self.screen.bottom_clearance() or self.hud.left != self.panel.width:
             self.hud.bottom = self.screen.bottom_clearance()
+            self.hud.left = self.panel.width
             self.hud.layout()
         if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + HUD_INTERVAL

@@ -367,10 +367,44 @@ class Simulation:
         for hook in self.after_step:
             hook()
 
+    def edit(self, change: Callable[[object], object], ghosts: bool = True) -> object:
+        """A change by hand between steps: ``change(world)`` (a World method that refuses bad values
+        with ValueError/TypeError and then changes nothing). The history keeps the changed state as the
+        present (re-stepping starts from it; any later steps are dropped) and, with ``ghosts``, each
+        ghost gets the same change, so an edited run is recorded and compared as what it is."""
+        result = change(self.world)
+        self.timeline.edited(change if ghosts else None)
+        return result
+
+    def remove_ball(self, index: int) -> None:
+        """Remove ball ``index`` (it and the ghosts' copies); what is kept per ball shrinks with it."""
+        self.edit(lambda world: world.remove_sphere(index))
+        look = self.appearance
+        look.sphere_colors = np.delete(look.sphere_colors, index, axis=0)
+        self.prev_positions = np.delete(self.prev_positions, index, axis=0)
+        self.prev_orientations = np.delete(self.prev_orientations, index, axis=0)
+        self.trails = Trails(self.ball_count)
+        self.trails.record(np.asarray(self.world.spheres.positions, dtype=np.float32), self.world.time)
+
+    def open(self, path: Path) -> bool:
+        """Open another scene file in place of this one; on any error keep the scene running and
+        remember the error (as a failed reload does)."""
+        path = Path(path)
+        try:
+            scene = self.loader(path)
+        except Exception as exc:  # any failure: the viewer must stay up with the old world
+            self.error = f"cannot open {path.name}: {_describe(exc)}"
+            print(f"ballpit: {self.error} (keeping the current scene)", file=sys.stderr, flush=True)
+            return False
+        self._install(scene)
+        self.error = None
+        self.message = f"opened {path.name}: press X to drop"
+        return True
+
     def add_ball(self, color: object, **kwargs: object) -> int:
         """Add a ball to the live world (``World.add_sphere`` arguments) drawn in ``color``; returns its
         index. Everything kept per ball (colours, trails, interpolation) grows with it."""
-        ball = self.world.add_sphere(**kwargs)
+        ball = self.edit(lambda world: world.add_sphere(**kwargs))
         look = self.appearance
         look.sphere_colors = np.vstack([look.sphere_colors, np.asarray(color, dtype=float).reshape(1, 3)])
         self.prev_positions = np.vstack([self.prev_positions, ball.position])

@@ -1,0 +1,93 @@
+"""Dear ImGui in the viewer's pyglet window: imgui-bundle's own pyglet backend, fed by the viewer.
+
+imgui-bundle ships a pyglet 2 backend on its OpenGL 3 (core profile) renderer
+(``imgui_bundle.python_backends.pyglet_backend``). Two things are changed here:
+
+- the viewer hands it the window's events itself (``attach_callbacks=False``), so it decides what
+  goes on to the 3-D view when ImGui does not want the mouse or keyboard;
+- the frame's time comes from ``perf_counter``: the backend's own ``process_inputs`` calls
+  ``pyglet.clock.tick()``, which would run the viewer's scheduled redraws from inside a frame.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import imgui_bundle
+from imgui_bundle import imgui, implot
+from imgui_bundle.python_backends.pyglet_backend import PygletProgrammablePipelineRenderer
+
+
+FONT = "DroidSans.ttf"
+FONT_SIZE = 15.0
+
+
+class PanelBackend:
+    """One ImGui (and ImPlot) context drawn into ``window``; ``new_frame`` … ``render`` per frame."""
+
+    def __init__(self, window: object) -> None:
+        self.window = window
+        self.context = imgui.create_context()
+        self.plot_context = implot.create_context()
+        io = imgui.get_io()
+        io.set_ini_filename("")  # no imgui.ini in the user's folder: the layout is the viewer's
+        io.config_flags |= imgui.ConfigFlags_.no_mouse_cursor_change
+        font = Path(imgui_bundle.__file__).parent / "assets" / "fonts" / FONT
+        if font.is_file():  # the wheel's Droid Sans: ×, °, … and ² that ImGui's own font lacks
+            io.font_default = io.fonts.add_font_from_file_ttf(str(font), FONT_SIZE)
+        self.renderer = PygletProgrammablePipelineRenderer(window, attach_callbacks=False)
+        self.renderer._window = window
+        self._last = time.perf_counter()
+        self._pointer: tuple[float, float] | None = None
+
+    # ------------------------------------------------------------------ events (window coordinates, y up)
+    def mouse_motion(self, x: float, y: float) -> None:
+        self.renderer.on_mouse_motion(x, y, 0, 0)
+        self._pointer = (x, y)
+
+    def mouse_button(self, x: float, y: float, button: int, down: bool) -> None:
+        self.mouse_motion(x, y)
+        self.renderer._on_mouse_button(button, down)
+
+    def scroll(self, x: float, y: float, scroll_x: float, scroll_y: float) -> None:
+        self.mouse_motion(x, y)
+        self.renderer.on_mouse_scroll(x, y, scroll_x, scroll_y)
+
+    def key(self, symbol: int, down: bool) -> None:
+        self.renderer._on_key(symbol, down)
+
+    def text(self, text: str) -> None:
+        self.renderer.on_text(text)
+
+    def resize(self) -> None:
+        self.renderer.on_resize(0, 0)
+
+    # ------------------------------------------------------------------ what ImGui wants
+    @property
+    def wants_keyboard(self) -> bool:
+        """A text field or a slider being typed into has the keyboard: keys do not reach the viewer."""
+        io = imgui.get_io()
+        return bool(io.want_capture_keyboard or io.want_text_input)
+
+    @property
+    def wants_mouse(self) -> bool:
+        return bool(imgui.get_io().want_capture_mouse)
+
+    # ------------------------------------------------------------------ the frame
+    def new_frame(self) -> None:
+        now = time.perf_counter()
+        io = imgui.get_io()
+        io.delta_time = min(max(now - self._last, 1e-4), 0.25)
+        self._last = now
+        self.renderer._set_pixel_ratio(self.window)
+        imgui.new_frame()
+
+    def render(self) -> None:
+        imgui.render()
+        self.renderer.render(imgui.get_draw_data())
+
+    def shutdown(self) -> None:
+        self.renderer.shutdown()
+        implot.destroy_context(self.plot_context)
+        imgui.destroy_context(self.context)
