@@ -345,7 +345,7 @@ def record_close_button(workdir: Path) -> dict:
     """--record: drop, reset, drop again, then the window's close button (pyglet's on_close)."""
     path = workdir / "live.toml"
     path.write_text(RAMP_SCENE)
-    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz")
+    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz", panel=False)
     viewer.sim.step_budget = math.inf
     press(viewer, "X", frames=20)
     press(viewer, "R", frames=2)

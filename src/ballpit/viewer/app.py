@@ -51,7 +51,8 @@ def title(scene_name: str, fps: float) -> str:
 class Viewer:
     """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
     file ``scene_path`` (the bundled demo by default). ``quality``: ``auto``, ``low`` or ``high``
-    (quality.py; auto is low on a software rasteriser such as llvmpipe, as in the window tests)."""
+    (quality.py; auto is low on a software rasteriser such as llvmpipe, as in the window tests).
+    ``panel``: whether the panel is shown at first (F4 shows and hides it)."""
 
     def __init__(
         self,
@@ -62,6 +63,7 @@ class Viewer:
         trajectory: object = None,
         record: Path | None = None,
         quality: str = "auto",
+        panel: bool = True,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -107,6 +109,7 @@ class Viewer:
         self.orbit = Orbit()
         self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
         self.panel = Panel(self)
+        self.panel.shown = panel
         self._last_press = (0.0, 0.0, 0.0)  # (time, x, y) of the last left press: a double-click orbits
         self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
@@ -173,8 +176,8 @@ class Viewer:
 
     def _needs(self) -> Needs:
         """What the physics should copy for the window (asked at every hand-over)."""
-        f, screen = self.flags, getattr(self, "screen", None)
-        return Needs(f.contacts, f.velocities, f.trails, energy=screen is not None and screen.show_plot)
+        f = self.flags
+        return Needs(f.contacts, f.velocities, f.trails)
 
     def _watch(self, sim: Simulation) -> object:
         """The panel's copy of the run (physics side, at each hand-over): settings, the selection,
@@ -219,7 +222,8 @@ class Viewer:
         from .picking import pick, pointer_ray
 
         w, h = self.window.width, self.window.height
-        ray = pointer_ray(self.camera, self.panel.width + (w - self.panel.width) / 2, h / 2, w, h)  # the view's centre
+        middle = self.panel.width + (w - self.panel.width) / 2  # the view's centre
+        ray = pointer_ray(self.camera, middle, h / 2, w, h)
 
         def aim(sim: Simulation) -> object:
             hit = pick(ray, sim.world)
@@ -330,6 +334,8 @@ class Viewer:
         self.finish_record()
         if not self._window_closed:
             self._window_closed = True
+            self.window.switch_to()
+            self.panel.backend.shutdown()
             self.window.close()
 
     def finish_record(self) -> None:
@@ -474,6 +480,8 @@ class Viewer:
         self.closed = True
         self.physics.stop()
         self.finish_record()
+        self.window.switch_to()
+        self.panel.backend.shutdown()  # before pyglet closes the window and its GL context
 
     def on_draw(self) -> None:
         self.frame()
@@ -498,6 +506,7 @@ class Viewer:
             # reads the file's signature and the error alone: the steps taken ahead stay (stepper.py)
             self.physics.submit(lambda sim: (sim.file_changed(), sim.error), self._watched, rewind=False)
         self.camera.inset = self.panel.width / max(self.window.width, 1)
+        self.screen.left = self.panel.width
         started = time.perf_counter()
         if dt is None:
             self.physics.run_free()
@@ -537,7 +546,7 @@ class Viewer:
             return None
         c = self.camera
         return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset, width, height,
-                self.flags.contacts, self.flags.velocities, self.flags.trails, self.screen.show_plot,
+                self.flags.contacts, self.flags.velocities, self.flags.trails, self.panel.width,
                 self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
     def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:

@@ -70,9 +70,16 @@ def typical_material(spheres: object) -> dict[str, float]:
     return dict(zip(names, (float(v) for v in kinds[best]), strict=True))
 
 
-def spring_velocity(position: np.ndarray, velocity: np.ndarray, target: np.ndarray, target_velocity: np.ndarray,
-                    h: float, hertz: float = SPRING_HERTZ, damping: float = SPRING_DAMPING,
-                    max_acceleration: float = SPRING_MAX_ACCELERATION) -> np.ndarray:  # fmt: skip
+def spring_velocity(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    target: np.ndarray,
+    target_velocity: np.ndarray,
+    h: float,
+    hertz: float = SPRING_HERTZ,
+    damping: float = SPRING_DAMPING,
+    max_acceleration: float = SPRING_MAX_ACCELERATION,
+) -> np.ndarray:
     """The velocity a ball has after one step ``h`` of a soft mouse joint pulling it to ``target``
     (Box2D v3, ``b2MakeSoft``: ω = 2πf, bias rate ω/(2ζ + hω), mass scale hω(2ζ + hω)/(1 + hω(2ζ + hω))).
     The ball's mass cancels: stiffness and damping are scaled by it. The change is at most

@@ -40,11 +40,13 @@ PROMPT = "press X or click Drop"
 PROMPT_SIZE = 40.0  # px, the first minute's prompt
 ERROR = ImVec4(1.0, 0.45, 0.4, 1.0)
 MUTED = ImVec4(0.65, 0.68, 0.75, 1.0)
-PLOT_HEIGHT = 140
+PLOT_HEIGHT = 200
 RECENT_LIMIT = 8
 DIALOG_TOOLS = ("zenity", "kdialog", "matedialog", "qarma")  # what portable_file_dialogs runs on Linux
 PLOTS = ("energy", "ball", "contacts", "stages")
-KINETIC, POTENTIAL = ImVec4(0.45, 0.95, 0.45, 1.0), ImVec4(0.45, 0.6, 1.0, 1.0)
+LEGEND = implot.LegendFlags_.outside | implot.LegendFlags_.horizontal  # never over the curves
+# pink and lavender: apart from every integrator's colour (red, orange, blue, green)
+KINETIC, POTENTIAL = ImVec4(1.0, 0.5, 0.9, 1.0), ImVec4(0.72, 0.62, 1.0, 1.0)
 
 
 def has_file_dialog() -> bool:
@@ -156,8 +158,12 @@ class Panel:
         scale = PROMPT_SIZE / imgui.get_font_size()
         tw, th = size.x * scale, size.y * scale
         x, y = left + (w - left - tw) / 2, h * 0.78 - th / 2  # over the ground, clear of the balls
-        draw.add_rect_filled(ImVec2(x - 18, y - 10), ImVec2(x + tw + 18, y + th + 10),
-                             imgui.get_color_u32(ImVec4(0.04, 0.05, 0.07, 0.72)), 10.0)  # fmt: skip
+        draw.add_rect_filled(
+            ImVec2(x - 18, y - 10),
+            ImVec2(x + tw + 18, y + th + 10),
+            imgui.get_color_u32(ImVec4(0.04, 0.05, 0.07, 0.72)),
+            10.0,
+        )
         draw.add_text(font, PROMPT_SIZE, ImVec2(x, y), imgui.get_color_u32(ImVec4(1, 1, 1, 1)), PROMPT)
         self.rects["prompt"] = (x, y, tw, th)
 
@@ -166,21 +172,33 @@ class Panel:
         imgui.set_next_window_pos(ImVec2(0, 0))
         imgui.set_next_window_size(ImVec2(WIDTH, h))
         imgui.set_next_window_bg_alpha(0.86)
-        flags = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_collapse
-                 | imgui.WindowFlags_.no_saved_settings)  # fmt: skip
+        flags = (
+            imgui.WindowFlags_.no_move
+            | imgui.WindowFlags_.no_resize
+            | imgui.WindowFlags_.no_collapse
+            | imgui.WindowFlags_.no_saved_settings
+        )
         imgui.begin("ballpit (F4 hides)", None, flags)
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self._window = (pos.x, pos.y, size.x, size.y)
         imgui.push_item_width(-130)
-        for name, body in (("Scenes", self._scenes), ("Simulation", self._simulation),
-                           ("Inspector", self._inspector), ("Plots", self._plots), ("View", self._view),
-                           ("Record video", self._record)):  # fmt: skip
-            if name in self._reopen:
+        for name, body in (
+            ("Scenes", self._scenes),
+            ("Simulation", self._simulation),
+            ("Inspector", self._inspector),
+            ("Plots", self._plots),
+            ("View", self._view),
+            ("Record video", self._record),
+        ):
+            reopened = name in self._reopen
+            if reopened:
                 imgui.set_next_item_open(True)
                 self._reopen.discard(name)
             elif name in self.sections:
                 imgui.set_next_item_open(self.sections[name], imgui.Cond_.once)
             opened = imgui.collapsing_header(name)
+            if reopened:  # opened by its key (P, F2): scrolled to the top of the panel
+                imgui.set_scroll_here_y(0.0)
             self._remember(f"section {name}")
             if name in self.sections:
                 self.sections[name] = opened
@@ -341,8 +359,9 @@ class Panel:
         self._remember("integrator")
         if changed:
             self.viewer.perform(IntegratorAction[names[k].upper()])
-        self._number("timestep ms", "world.timestep", w.timestep * 1e3,
-                     lambda v: self.edits.world("timestep", v / 1e3))  # fmt: skip
+        self._number(
+            "timestep ms", "world.timestep", w.timestep * 1e3, lambda v: self.edits.world("timestep", v / 1e3)
+        )
         _, substeps = imgui.input_int("substeps", w.substeps)
         self._remember("world.substeps")
         if imgui.is_item_deactivated_after_edit() or (substeps != w.substeps and not imgui.is_item_active()):
@@ -362,23 +381,33 @@ class Panel:
         if automatic:
             imgui.text(f"threshold {w.threshold_used:.3g} m/s")
         else:
-            self._number("threshold m/s", "world.restitution_threshold", w.restitution_threshold,
-                         lambda v: self.edits.world("restitution_threshold", v))  # fmt: skip
+            self._number(
+                "threshold m/s",
+                "world.restitution_threshold",
+                w.restitution_threshold,
+                lambda v: self.edits.world("restitution_threshold", v),
+            )
         self._error("world.time_scale")
         self._error("world.sleep")
         imgui.push_text_wrap_pos(0.0)
-        imgui.text_colored(MUTED, f"At once (and kept by Reset): {', '.join(AT_ONCE).replace('_', ' ')}. "
-                                  f"On reset: {', '.join(ON_RESET)} (changing it resets the run).")  # fmt: skip
+        at_once = ", ".join(AT_ONCE).replace("_", " ")
+        imgui.text_colored(
+            MUTED,
+            f"At once (and kept by Reset): {at_once}. On reset: {', '.join(ON_RESET)} "
+            "(changing it resets the run).",
+        )
         imgui.pop_text_wrap_pos()
 
     # ------------------------------------------------------------------ Inspector
     def _inspector(self, shown: Shown, watch: Watch) -> None:
         s = watch.selected
         imgui.push_text_wrap_pos(0.0)
-        imgui.text_colored(MUTED, "Click a ball or a plane to select it; drag a ball to pull it; "
-                                  "double-click a ball to orbit it.")  # fmt: skip
+        imgui.text_colored(
+            MUTED,
+            "Click a ball or a plane to select it; drag a ball to pull it; double-click a ball to orbit it.",
+        )
         imgui.pop_text_wrap_pos()
-        changed, self.adding_ball = imgui.checkbox("add a ball where I click", self.adding_ball)
+        _, self.adding_ball = imgui.checkbox("add a ball where I click", self.adding_ball)
         self._remember("add ball")
         self._error("add")
         if isinstance(s, BallFacts):
@@ -396,8 +425,12 @@ class Panel:
         imgui.text(f"speed {speed:.3f} m/s   spin {np.sqrt((b.spin * b.spin).sum()):.3f} rad/s")
         imgui.text(f"kinetic {b.kinetic:.4g} J   potential {b.potential:.4g} J")
         for name in ("radius", "mass", "restitution", "friction", "rolling_friction"):
-            self._number(name.replace("_", " "), f"ball.{name}", getattr(b, name),
-                         lambda v, n=name: self.edits.ball(i, n, v))  # fmt: skip
+            self._number(
+                name.replace("_", " "),
+                f"ball.{name}",
+                getattr(b, name),
+                lambda v, n=name: self.edits.ball(i, n, v),
+            )
         self._vector("velocity", "ball.velocity", b.velocity, lambda v: self.edits.ball(i, "velocity", v))
         if imgui.button("Delete ball"):
             self.edits.remove_ball(i, lambda _: self.viewer.select(None))
@@ -416,17 +449,29 @@ class Panel:
             "angles °", "plane.rotation", p.rotation, lambda v: self.edits.plane(i, "rotation", v), "%.2f"
         )
         for name in ("restitution", "friction", "rolling_friction"):
-            self._number(name.replace("_", " "), f"plane.{name}", getattr(p, name),
-                         lambda v, n=name: self.edits.plane(i, n, v))  # fmt: skip
+            self._number(
+                name.replace("_", " "),
+                f"plane.{name}",
+                getattr(p, name),
+                lambda v, n=name: self.edits.plane(i, n, v),
+            )
         self._vector("velocity", "plane.velocity", p.velocity, lambda v: self.edits.plane(i, "velocity", v))
-        self._vector("spin", "plane.angular_velocity", p.angular_velocity,
-                     lambda v: self.edits.plane(i, "angular_velocity", v))  # fmt: skip
+        self._vector(
+            "spin",
+            "plane.angular_velocity",
+            p.angular_velocity,
+            lambda v: self.edits.plane(i, "angular_velocity", v),
+        )
 
     # ------------------------------------------------------------------ Plots
     def _plots(self, shown: Shown, watch: Watch) -> None:
-        for name, text in (("energy", "energy (P)"), ("ball", "selected ball"), ("contacts", "contacts"),
-                           ("stages", "time per stage (F2)")):  # fmt: skip
-            changed, self.plots[name] = imgui.checkbox(text, self.plots[name])
+        for name, text in (
+            ("energy", "energy (P)"),
+            ("ball", "selected ball"),
+            ("contacts", "contacts"),
+            ("stages", "time per stage (F2)"),
+        ):
+            _, self.plots[name] = imgui.checkbox(text, self.plots[name])
             self._remember(f"plot {name}")
             if name in ("energy", "ball"):
                 imgui.same_line()
@@ -436,23 +481,25 @@ class Panel:
             return
         size = ImVec2(-1, PLOT_HEIGHT)
         fit = implot.AxisFlags_.auto_fit
-        if self.plots["energy"] and traces.energy and implot.begin_plot("energy", size):
+        title = "energy: K kinetic, U potential"
+        if self.plots["energy"] and traces.energy and implot.begin_plot(f"{title}##energy", size):
             self._remember("plot area energy")
             implot.setup_axes("t s", "J", fit, fit)
+            implot.setup_legend(implot.Location_.north, LEGEND)
             e = traces.energy
             t = e["time"]
-            implot.plot_line("kinetic", t, e["kinetic"], _spec(KINETIC))
-            implot.plot_line("potential", t, e["potential"], _spec(POTENTIAL))
-            for key, values in e.items():
-                if key.startswith("total "):
-                    name = key[6:]
-                    implot.plot_line(
-                        f"total {LABELS.get(name, name)}", t, values, _spec((*TINTS[name], 1.0), 2.0)
-                    )
+            implot.plot_line("K", t, e["kinetic"], _spec(KINETIC))
+            implot.plot_line("U", t, e["potential"], _spec(POTENTIAL))
+            totals = [key[6:] for key in e if key.startswith("total ")]
+            main = watch.world.integrator
+            for name in sorted(totals, key=lambda n: n == main):  # the run's own total on top
+                label = LABELS.get(name, name) if len(totals) > 1 else "E"
+                implot.plot_line(label, t, e[f"total {name}"], _spec((*TINTS[name], 1.0), 2.0))
             implot.end_plot()
         if self.plots["ball"] and implot.begin_plot("selected ball", size):
             self._remember("plot area ball")
             implot.setup_axes("t s", "m, m/s", fit, fit)
+            implot.setup_legend(implot.Location_.north, LEGEND)
             if traces.ball is not None and len(traces.time):
                 implot.plot_line("height", traces.time, traces.height)
                 implot.plot_line("speed", traces.time, traces.speed)
@@ -480,9 +527,14 @@ class Panel:
     # ------------------------------------------------------------------ View
     def _view(self, shown: Shown, watch: Watch) -> None:
         v = self.viewer
-        toggles = ((Action.CONTACTS, "contacts", v.flags.contacts), (Action.VELOCITIES, "velocities", v.flags.velocities),
-                   (Action.TRAILS, "trails", v.flags.trails), (Action.HUD, "HUD", v.hud.show_hud),
-                   (Action.GHOSTS, "ghosts", bool(shown.ghosts)), (Action.QUALITY, "high quality", v.multisample))  # fmt: skip
+        toggles = (
+            (Action.CONTACTS, "contacts", v.flags.contacts),
+            (Action.VELOCITIES, "velocities", v.flags.velocities),
+            (Action.TRAILS, "trails", v.flags.trails),
+            (Action.HUD, "HUD", v.hud.show_hud),
+            (Action.GHOSTS, "ghosts", bool(shown.ghosts)),
+            (Action.QUALITY, "high quality", v.multisample),
+        )
         for action, text, on in toggles:
             if imgui.checkbox(actions.label(action, text), on)[0]:
                 v.perform(action)
@@ -504,8 +556,9 @@ class Panel:
         if changed and not orbit.follow_wanted:
             orbit.follow = None
         imgui.push_text_wrap_pos(0.0)
-        imgui.text_colored(MUTED, "orbit: drag turns, scroll zooms, middle button pans; "
-                                  "double-click a ball to orbit it")  # fmt: skip
+        imgui.text_colored(
+            MUTED, "orbit: drag turns, scroll zooms, middle button pans; double-click a ball to orbit it"
+        )
         imgui.pop_text_wrap_pos()
         self._action_button(Action.HOME, "Scene's view")
 

@@ -18,7 +18,6 @@ import imgui_bundle
 from imgui_bundle import imgui, implot
 from imgui_bundle.python_backends.pyglet_backend import PygletProgrammablePipelineRenderer
 
-
 FONT = "DroidSans.ttf"
 FONT_SIZE = 15.0
 
@@ -41,41 +40,55 @@ class PanelBackend:
         self._last = time.perf_counter()
         self._pointer: tuple[float, float] | None = None
 
+    def activate(self) -> None:
+        """Make this panel's ImGui and ImPlot contexts current (each window has its own)."""
+        imgui.set_current_context(self.context)
+        implot.set_current_context(self.plot_context)
+
     # ------------------------------------------------------------------ events (window coordinates, y up)
     def mouse_motion(self, x: float, y: float) -> None:
+        self.activate()
         self.renderer.on_mouse_motion(x, y, 0, 0)
         self._pointer = (x, y)
 
     def mouse_button(self, x: float, y: float, button: int, down: bool) -> None:
+        self.activate()
         self.mouse_motion(x, y)
         self.renderer._on_mouse_button(button, down)
 
     def scroll(self, x: float, y: float, scroll_x: float, scroll_y: float) -> None:
+        self.activate()
         self.mouse_motion(x, y)
         self.renderer.on_mouse_scroll(x, y, scroll_x, scroll_y)
 
     def key(self, symbol: int, down: bool) -> None:
+        self.activate()
         self.renderer._on_key(symbol, down)
 
     def text(self, text: str) -> None:
+        self.activate()
         self.renderer.on_text(text)
 
     def resize(self) -> None:
+        self.activate()
         self.renderer.on_resize(0, 0)
 
     # ------------------------------------------------------------------ what ImGui wants
     @property
     def wants_keyboard(self) -> bool:
         """A text field or a slider being typed into has the keyboard: keys do not reach the viewer."""
+        self.activate()
         io = imgui.get_io()
         return bool(io.want_capture_keyboard or io.want_text_input)
 
     @property
     def wants_mouse(self) -> bool:
+        self.activate()
         return bool(imgui.get_io().want_capture_mouse)
 
     # ------------------------------------------------------------------ the frame
     def new_frame(self) -> None:
+        self.activate()
         now = time.perf_counter()
         io = imgui.get_io()
         io.delta_time = min(max(now - self._last, 1e-4), 0.25)
@@ -88,6 +101,11 @@ class PanelBackend:
         self.renderer.render(imgui.get_draw_data())
 
     def shutdown(self) -> None:
+        """Free the GL objects (with the window's context current) and the contexts."""
+        if self.context is None:
+            return
+        self.activate()
         self.renderer.shutdown()
         implot.destroy_context(self.plot_context)
         imgui.destroy_context(self.context)
+        self.context = None

@@ -83,7 +83,10 @@ class PhysicsThread:
     """Steps one Simulation beside the window and hands over a ``Shown`` after every batch of steps."""
 
     def __init__(
-        self, sim: Simulation, needs: Callable[[], Needs] = Needs, watch: Callable[[Simulation], Any] | None = None
+        self,
+        sim: Simulation,
+        needs: Callable[[], Needs] = Needs,
+        watch: Callable[[Simulation], Any] | None = None,
     ) -> None:
         self.sim = sim
         self.needs = needs  # what the window draws now (asked at each capture)

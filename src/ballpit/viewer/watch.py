@@ -165,8 +165,20 @@ def ball_facts(sim: Simulation, index: int) -> BallFacts | None:
             (np.asarray(c.kind) == SPHERE_SPHERE) & (np.asarray(c.b) == index)
         )
         contacts = int(mine.sum())
-    return BallFacts(index, np.array(b.position, dtype=float), v, w, b.radius, b.mass, b.restitution, b.friction,
-                     b.rolling_friction, kinetic, potential, contacts)  # fmt: skip
+    return BallFacts(
+        index,
+        np.array(b.position, dtype=float),
+        v,
+        w,
+        b.radius,
+        b.mass,
+        b.restitution,
+        b.friction,
+        b.rolling_friction,
+        kinetic,
+        potential,
+        contacts,
+    )
 
 
 def plane_facts(sim: Simulation, index: int) -> PlaneFacts | None:
