@@ -141,7 +141,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("right drag or Tab", "look around (Tab captures the mouse)"),
     ("Esc", "release the mouse, drop a plane; twice quits"),
     ("C / V / T, P", "contacts, velocities, trails; energy plot"),
-    ("H F1 F2 F3 F4", "HUD, help, stage times, quality, panel"),
+    ("H / F1 F2 F3 F4", "HUD, help, stage times, quality, panel"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),
     ("B / Shift+B", "shoot a ball along the view / its speed"),
