@@ -106,19 +106,21 @@ def add_ball_at(sim: Simulation, ray: Ray) -> int:
     from ballpit.scene.colours import palette_colors
 
     from .interaction import typical_material
-    from .picking import pick
+    from .picking import ray_planes
 
-    hit = pick(ray, sim.world)
-    if hit is None or hit.kind != "plane":
+    planes = sim.world.planes
+    u, v = (np.array([p.axes[k] for p in planes]).reshape(-1, 3) for k in (0, 1))
+    index, distance = ray_planes(ray, planes.centers, planes.normals, u, v, planes.half_sizes)
+    if index < 0:
         raise ValueError("point at a plane to add a ball on it")
     spheres = sim.world.spheres
     radius = float(np.median(spheres.radii)) if len(spheres) else 0.25
     mass = float(np.median(spheres.masses)) if len(spheres) else 1.0
-    n = np.array(sim.world.planes[hit.index].normal, dtype=float)
+    n = np.array(planes[index].normal, dtype=float)
     if float((n * ray.direction).sum()) > 0.0:  # the side facing the viewer
         n = -n
     color = palette_colors(1, first=len(spheres))[0]
-    position = np.asarray(hit.point, dtype=float) + n * (radius + NEW_BALL_GAP)
+    position = ray.at(distance) + n * (radius + NEW_BALL_GAP)
     cut = sim.world.first_overlap(position, radius)
     if cut is not None:
         where = ", ".join(f"{c:.2f}" for c in position)

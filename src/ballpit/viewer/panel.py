@@ -220,15 +220,17 @@ class Panel:
         return clicked
 
     def _error(self, key: str) -> None:
+        """The error of a refused edit, in red under its widget (until an edit of it succeeds)."""
         error = self.edits.error(key)
         if error:
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(ERROR, error)
             imgui.pop_text_wrap_pos()
+            self._remember(f"error {key}")
 
     def _number(self, label: str, key: str, value: float, send, fmt: str = "%.4g") -> None:
         """A typed number, sent when the field is left or Enter pressed (a refusal shows below it)."""
-        _, typed = imgui.input_float(label, float(value), 0.0, 0.0, fmt)
+        _, typed = imgui.input_double(label, float(value), 0.0, 0.0, fmt)
         self._remember(key)
         if imgui.is_item_deactivated_after_edit():
             send(typed)
@@ -237,8 +239,8 @@ class Panel:
     def _vector(self, label: str, key: str, value: object, send, fmt: str = "%.3f") -> None:
         _, typed = imgui.input_float3(label, [float(v) for v in value], fmt)
         self._remember(key)
-        if imgui.is_item_deactivated_after_edit():
-            send(tuple(typed))
+        if imgui.is_item_deactivated_after_edit():  # ImGui's fields hold 32-bit floats: send what was typed
+            send(tuple(float(f"{v:.7g}") for v in typed))
         self._error(key)
 
     # ------------------------------------------------------------------ Scenes
