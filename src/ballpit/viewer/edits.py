@@ -10,6 +10,7 @@ and no ImGui here, so what each widget commands is tested without a window.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -89,7 +90,8 @@ def set_world(sim: Simulation, name: str, value: object) -> None:
     if name == "timestep":
         from ballpit.physics import validation
 
-        sim.scene.timestep = validation.number("timestep", value, positive=True, within=(1e-5, 0.1))
+        timestep = validation.number("timestep", value, positive=True, within=(1e-5, 0.1))
+        sim.scene = dataclasses.replace(sim.scene, timestep=timestep)
         sim.reset()
         sim.message = f"timestep {sim.scene.timestep * 1000:g} ms: reset, X drops"
         return
