@@ -89,6 +89,9 @@ class Panel:
         self._dialog_kind = ""
         self.seconds: deque[float] = deque(maxlen=240)  # building and drawing the panel, per frame
         self._window = (0.0, 0.0, 0.0, 0.0)
+        self._bundled = [path.resolve() for path in bundled_scenes()]
+        self._path: object = None  # the scene file shown, and its resolved path
+        self._current: Path | None = None
 
     # ------------------------------------------------------------------ what the window asks
     @property
@@ -245,10 +248,12 @@ class Panel:
 
     # ------------------------------------------------------------------ Scenes
     def _scenes(self, shown: Shown, watch: Watch) -> None:
-        current = Path(watch.world.path).resolve() if watch.world.path else None
+        if watch.world.path != self._path:  # resolved once per scene, not every frame
+            self._path = watch.world.path
+            self._current = Path(self._path).resolve() if self._path else None
         imgui.text_colored(MUTED, "bundled scenes: one click opens")
-        for path in bundled_scenes():
-            picked, _ = imgui.selectable(path.stem, current == path.resolve())
+        for path in self._bundled:
+            picked, _ = imgui.selectable(path.stem, self._current == path)
             self._remember(f"scene {path.stem}")
             if picked:
                 self.open_scene(path)
