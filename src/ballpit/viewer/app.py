@@ -110,6 +110,7 @@ class Viewer:
         self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
         self.panel = Panel(self)
         self.panel.shown = panel
+        self.scene_view(self.shown)
         self._last_press = (0.0, 0.0, 0.0)  # (time, x, y) of the last left press: a double-click orbits
         self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
@@ -209,10 +210,10 @@ class Viewer:
 
     def scene_opened(self) -> None:
         """Another scene was opened: the camera goes to its view."""
-        look = self.sim.appearance
+        self.physics.sync()  # its first hand-over, to frame it from
         self.orbit.stop()
-        self.camera.look_from(look.camera_position, look.camera_look_at)
-        self.window.set_caption(title(look.name, self.fps))
+        self.scene_view(self.shown)
+        self.window.set_caption(title(self.shown.appearance.name, self.fps))
 
     def start_orbit(self, target: object = None, ball: int | None = None) -> None:
         """Orbit ``target`` (by default what the view's centre shows, else the scene's look-at point)."""
@@ -257,9 +258,20 @@ class Viewer:
 
     def home(self) -> None:
         """Home: the camera back to the scene's view (the free-fly camera)."""
-        look = self.shown.appearance
-        self.camera.look_from(look.camera_position, look.camera_look_at)
         self.orbit.stop()
+        self.scene_view(self.shown)
+
+    def scene_view(self, shown: Shown) -> None:
+        """The camera where the scene file puts it; a scene with no ground is framed so that it fills
+        the view right of the panel (framing.py)."""
+        from .framing import fit, scene_box
+
+        look = shown.appearance
+        self.camera.look_from(look.camera_position, look.camera_look_at)
+        self.camera.inset = self.panel.width / max(self.window.width, 1)
+        box = scene_box(shown)
+        if box is not None:
+            fit(self.camera, look.camera_look_at, box, self.window.width, self.window.height)
 
     def escape(self) -> None:
         """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;

@@ -90,6 +90,8 @@ class Panel:
         self.seconds: deque[float] = deque(maxlen=240)  # building and drawing the panel, per frame
         self._window = (0.0, 0.0, 0.0, 0.0)
         self._bundled = [path.resolve() for path in bundled_scenes()]
+        self._prompt_key: tuple = ()
+        self._prompt_y = 0.0
         self._path: object = None  # the scene file shown, and its resolved path
         self._current: Path | None = None
 
@@ -142,7 +144,7 @@ class Panel:
         else:
             self._window = (0.0, 0.0, 0.0, 0.0)
         if watch is not None and watch.world.phase is Phase.WAITING and not watch.world.replay:
-            self._prompt()
+            self._prompt(shown)
         self._poll_dialog()
         self.backend.render()
         self.seconds.append(time.perf_counter() - started)
@@ -151,16 +153,18 @@ class Panel:
         lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
         self.rects[key] = (lo.x, lo.y, hi.x - lo.x, hi.y - lo.y)
 
-    def _prompt(self) -> None:
-        """The first minute: a large centred "press X or click Drop" over the 3-D view."""
-        w, h = self.viewer.window.width, self.viewer.window.height
+    def _prompt(self, shown: Shown) -> None:
+        """The first minute: a large "press X or click Drop", centred across the 3-D view, at the
+        height nearest the middle where it covers no ball."""
+        w = self.viewer.window.width
         left = self.width
         draw = imgui.get_foreground_draw_list()
         font = imgui.get_font()
         size = imgui.calc_text_size(PROMPT)
         scale = PROMPT_SIZE / imgui.get_font_size()
         tw, th = size.x * scale, size.y * scale
-        x, y = left + (w - left - tw) / 2, h * 0.78 - th / 2  # over the ground, clear of the balls
+        x = left + (w - left - tw) / 2
+        y = self._prompt_height(shown, x, tw, th)
         draw.add_rect_filled(
             ImVec2(x - 18, y - 10),
             ImVec2(x + tw + 18, y + th + 10),
@@ -169,6 +173,32 @@ class Panel:
         )
         draw.add_text(font, PROMPT_SIZE, ImVec2(x, y), imgui.get_color_u32(ImVec4(1, 1, 1, 1)), PROMPT)
         self.rects["prompt"] = (x, y, tw, th)
+
+    def _prompt_height(self, shown: Shown, x: float, tw: float, th: float) -> float:
+        """The top of the prompt: the first of some heights, from the middle outwards, whose band
+        (padded) holds no ball as drawn; the middle if every one does. Worked out again only when the
+        balls or the camera change."""
+        camera = self.viewer.camera
+        w, h = self.viewer.window.width, self.viewer.window.height
+        key = (id(shown), tuple(camera.position), camera.yaw, camera.pitch, camera.inset, w, h)
+        if key == self._prompt_key:
+            return self._prompt_y
+        pixels, depth = camera.project(shown.positions, w, h) if shown.ball_count else (np.zeros((0, 2)), [])
+        self._prompt_key, self._prompt_y = key, h * 0.5 - th / 2
+        front = np.asarray(depth) > 0
+        px = pixels[front]
+        for share in (0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9):
+            top = h * share - th / 2
+            inside = (
+                (px[:, 0] > x - 40)
+                & (px[:, 0] < x + tw + 40)
+                & (px[:, 1] > top - 30)
+                & (px[:, 1] < top + th + 30)
+            )
+            if not inside.any():
+                self._prompt_y = top
+                break
+        return self._prompt_y
 
     def _panel(self, shown: Shown, watch: Watch) -> None:
         h = self.viewer.window.height
