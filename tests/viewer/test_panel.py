@@ -24,7 +24,12 @@ def test_clicking_a_scene_in_the_list_loads_it_and_f4_hides_the_panel(xvfb, tmp_
     r = run_scenario(xvfb, "scene_list", tmp_path)
     assert r["before"] == "slopes.toml" and r["after"] == "cradle.toml"
     assert r["balls"] == 6 and r["phase"] == "WAITING"
-    assert r["camera"] == r["scene_camera"]  # the camera went to the new scene's view
+    # the camera went to the new scene's view: on the file's line of sight to its look-at point (with no
+    # ground, the cradle is framed to fill the view: only the distance along that line changes)
+    target, eye, filed = (np.array(r[k]) for k in ("look_at", "camera", "scene_camera"))
+    along = (filed - target) / np.linalg.norm(filed - target)
+    assert np.allclose((eye - target) / np.linalg.norm(eye - target), along, atol=1e-9)
+    assert np.allclose(r["forward"], -along, atol=1e-9)
     assert "cradle.toml" in r["title"] and r["recent"] == ["cradle.toml"]
     assert r["hud_x_shown"] >= r["panel_width"]  # the HUD sits right of the panel
     assert r["panel_after_f4"] is False and r["hud_x_hidden"] < 20 and r["inset_hidden"] == 0.0

@@ -76,7 +76,7 @@ def _shot_speed(v: Viewer) -> None:
 
 
 def _home(v: Viewer) -> None:
-    v.home()
+    v.view.home()
 
 
 def _panel(v: Viewer) -> None:
@@ -91,8 +91,8 @@ HANDLERS: dict[Enum, Handler] = {
     Action.RELOAD: lambda v: v.reload(),
     Action.FASTER: _command(lambda sim: sim.faster()),
     Action.SLOWER: _command(lambda sim: sim.slower()),
-    Action.CAPTURE_MOUSE: lambda v: v.capture_mouse(not v.mouse_captured),
-    Action.ESCAPE: lambda v: v.escape(),
+    Action.CAPTURE_MOUSE: lambda v: v.input.capture_mouse(not v.input.mouse_captured),
+    Action.ESCAPE: lambda v: v.input.escape(),
     Action.CONTACTS: _flip_flag("contacts"),
     Action.VELOCITIES: _flip_flag("velocities"),
     Action.TRAILS: _flip_flag("trails"),

@@ -1,7 +1,10 @@
-"""The viewer window: pyglet event loop, input handling, camera flying, HUD, reload and screenshots.
+"""The viewer window: its parts put together, the frame, reload and save, the HUD's text, and the exit.
 
 ``run`` is what ``ballpit`` / ``ballpit view`` call. ``Viewer`` is the window itself; tests drive it
-frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window.
+frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window. Its parts
+live beside it: the input (input.py: keys, pointer, files), the actions every key and panel button run
+(actions.py), the camera (view_control.py, orbit.py, framing.py), the panel (panel.py), the HUD
+(hud.py), recording (recording.py) and screenshots (screenshot.py).
 
 The physics runs beside the window on a thread of its own (stepper.py): the window draws the latest
 state it handed over and sends it what the keys and the mouse ask as commands, applied between steps.
@@ -16,10 +19,9 @@ import copy
 import sys
 import time
 from collections import deque
-from datetime import datetime
 from pathlib import Path
 
-from . import backend, controls
+from . import backend
 from .controls import Action
 from .handover import Needs, Shown
 from .pacing import FramePacer
@@ -28,8 +30,6 @@ from .simulation import Phase, Simulation
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
-SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
-DOUBLE_CLICK_SECONDS = 0.35  # a second left press within this time, at the same place, is a double-click
 
 
 def default_scene() -> Path:
@@ -71,12 +71,13 @@ class Viewer:
         from .camera import Camera
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
+        from .input import WindowInput
         from .interaction import Interaction
-        from .orbit import Orbit
         from .panel import Panel
         from .renderer import Renderer
         from .screen import ScreenOverlay
         from .stepper import PhysicsThread
+        from .view_control import ViewControl
         from .watch import Traces
 
         if world is None:
@@ -95,6 +96,8 @@ class Viewer:
             self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
+        self.view = ViewControl(self, self.camera)
+        self.orbit = self.view.orbit
         self.window = self._open_window(size, visible)
         self.renderer = Renderer()
         self.renderer_name = _gl_renderer()
@@ -106,12 +109,10 @@ class Viewer:
         self.traces = Traces()
         self.sim.after_step.append(lambda: self.traces.sample(self.sim))
         self.sim.after_reset.append(lambda: self.traces.follow(None))
-        self.orbit = Orbit()
         self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
         self.panel = Panel(self)
         self.panel.shown = panel
-        self.scene_view(self.shown)
-        self._last_press = (0.0, 0.0, 0.0)  # (time, x, y) of the last left press: a double-click orbits
+        self.view.scene_view(self.shown)
         self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
@@ -122,9 +123,7 @@ class Viewer:
         self._drawn_key: tuple | None = None
         self._drawn_shown: Shown | None = None  # keeps the object whose id is in the key alive
         self.views_drawn = 0  # how many frames drew the 3-D view (others showed the last one again)
-        self.held: set[str] = set()
-        self.mouse_captured = False
-        self._quit_armed_until = 0.0  # a second Esc before this time quits
+        self.input = WindowInput(self)
         self.closed = False
         self._window_closed = False
         self.screenshot_requested = False
@@ -141,6 +140,7 @@ class Viewer:
         self._shown_message = ""
         self.window.set_caption(title(look.name, 0.0))
         self.window.push_handlers(self)
+        self.window.push_handlers(self.input)
         self._pyglet = pyglet
 
     # ------------------------------------------------------------------ window
@@ -212,25 +212,17 @@ class Viewer:
         """Another scene was opened: the camera goes to its view."""
         self.physics.sync()  # its first hand-over, to frame it from
         self.orbit.stop()
-        self.scene_view(self.shown)
+        self.view.scene_view(self.shown)
         self.window.set_caption(title(self.shown.appearance.name, self.fps))
 
-    def start_orbit(self, target: object = None, ball: int | None = None) -> None:
-        """Orbit ``target`` (by default what the view's centre shows, else the scene's look-at point)."""
-        if target is not None:
-            self.orbit.start(self.camera, target, ball)
-            return
-        from .picking import pick, pointer_ray
+    # the input's state, read by the HUD, the actions and the tests
+    @property
+    def held(self) -> set[str]:
+        return self.input.held
 
-        w, h = self.window.width, self.window.height
-        middle = self.panel.width + (w - self.panel.width) / 2  # the view's centre
-        ray = pointer_ray(self.camera, middle, h / 2, w, h)
-
-        def aim(sim: Simulation) -> object:
-            hit = pick(ray, sim.world)
-            return hit.point if hit is not None else sim.appearance.camera_look_at
-
-        self.command(aim, lambda point: self.orbit.start(self.camera, point))
+    @property
+    def mouse_captured(self) -> bool:
+        return self.input.mouse_captured
 
     @property
     def shown(self) -> Shown:
@@ -255,40 +247,6 @@ class Viewer:
         perform(self, action)
         self._hud_at = 0.0  # refresh the HUD on the next frame
         self.physics.refresh_hud()
-
-    def home(self) -> None:
-        """Home: the camera back to the scene's view (the free-fly camera)."""
-        self.orbit.stop()
-        self.scene_view(self.shown)
-
-    def scene_view(self, shown: Shown) -> None:
-        """The camera where the scene file puts it; a scene with no ground is framed so that it fills
-        the view right of the panel (framing.py)."""
-        from .framing import fit, scene_box
-
-        look = shown.appearance
-        self.camera.look_from(look.camera_position, look.camera_look_at)
-        self.camera.inset = self.panel.width / max(self.window.width, 1)
-        box = scene_box(shown)
-        if box is not None:
-            fit(self.camera, look.camera_look_at, box, self.window.width, self.window.height)
-
-    def escape(self) -> None:
-        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
-        until then the HUD asks for it."""
-        now = time.perf_counter()
-        if not self.mouse_captured and self.interaction.selected_plane is not None:
-            self.command(lambda sim: self.interaction.deselect())
-            self.hud.flash("plane deselected", now)
-            return
-        outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
-        if outcome == "quit":
-            self.close()
-            return
-        if outcome == "release":
-            self.capture_mouse(False)
-        self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
-        self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 
     def _watched(self, result: tuple[bool, str | None]) -> None:
         """The file watch's answer: the HUD's error, and a reload when the file changed."""
@@ -324,15 +282,8 @@ class Viewer:
             self.hud.flash(f"save failed: {result}", time.perf_counter())
             return
         self.last_save = result
-        shown = self.last_save
-        if shown.is_relative_to(Path.cwd()):
-            shown = shown.relative_to(Path.cwd())
         print(f"scene saved to {self.last_save}", flush=True)
-        self.hud.flash(f"scene saved to {shown}", time.perf_counter())
-
-    def capture_mouse(self, captured: bool) -> None:
-        self.mouse_captured = captured
-        self.window.set_exclusive_mouse(captured)
+        self.hud.flash(f"scene saved to {_near(self.last_save)}", time.perf_counter())
 
     def close(self) -> None:
         """Close the window. Outside pyglet's loop (``pump``) the close waits until the events being
@@ -362,128 +313,6 @@ class Viewer:
                 path, steps, balls = finished
                 print(f"recorded {steps} steps ({balls} balls) to {path}", flush=True)
 
-    # ------------------------------------------------------------------ pyglet events
-    def on_key_press(self, symbol: int, modifiers: int) -> bool:
-        from pyglet.window import key
-
-        self.panel.backend.key(symbol, True)
-        if self.panel.wants_keyboard:  # typing into a field of the panel
-            return True
-        name = key.symbol_string(symbol)
-        ctrl = bool(modifiers & key.MOD_ACCEL)
-        if not (ctrl and name in controls.FLY_KEYS):  # Ctrl+S saves; it does not fly back
-            self.held.add(name)
-        if self.interaction.takes_key(name):  # arrows and PgUp/PgDn move a selected plane while held
-            return True
-        action = controls.action_for_key(name, ctrl=ctrl, shift=bool(modifiers & key.MOD_SHIFT))
-        if action is not None:
-            self.perform(action)
-        return True  # handled: stops pyglet's default "Esc closes the window"
-
-    def on_text(self, text: str) -> bool:
-        self.panel.backend.text(text)
-        if self.panel.wants_keyboard:
-            return True
-        action = controls.action_for_text(text)
-        if action is not None:
-            self.perform(action)
-        return True
-
-    def on_key_release(self, symbol: int, modifiers: int) -> bool:
-        from pyglet.window import key
-
-        self.panel.backend.key(symbol, False)
-        self.held.discard(key.symbol_string(symbol))
-        return True
-
-    def on_deactivate(self) -> None:
-        self.held.clear()
-
-    def on_file_drop(self, x: int, y: int, paths: list[str]) -> None:
-        """A file dropped on the window: a scene opens (one that is not valid keeps the current one)."""
-        if paths:
-            self.panel.open_scene(Path(paths[0]))
-
-    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        self.panel.backend.mouse_button(x, y, button, True)
-        if self.panel.covers(x, y):
-            return
-        if button == mouse.LEFT and self.screen.press(x, y):  # on the timeline bar: scrub
-            return
-        from .picking import pointer_ray
-
-        if button == mouse.LEFT and not self.mouse_captured:
-            ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
-            facing = self.camera.forward
-            now = time.perf_counter()
-            t, px, py = self._last_press
-            double = now - t < DOUBLE_CLICK_SECONDS and abs(x - px) + abs(y - py) < 6
-            self._last_press = (0.0 if double else now, x, y)
-            if self.panel.adding_ball:
-                self.add_ball_at(ray)
-                return
-
-            def press(sim: Simulation) -> None:
-                sim.message = self.interaction.press(ray, x, y, facing) or sim.message
-
-            self.command(press, (lambda _: self._orbit_clicked()) if double else None)
-
-    def add_ball_at(self, ray: object) -> None:
-        """The inspector's "add a ball where I click": a ball resting on the plane clicked."""
-        self.panel.edits.add_ball(ray, lambda index: self.select(index))
-
-    def _orbit_clicked(self) -> None:
-        """A double-click on a ball: orbit it (and follow it, if the View section asks)."""
-        ball = self.interaction.selected_ball
-        if ball is None or ball >= self.shown.ball_count:
-            return
-        self.command(lambda sim: self.interaction.release())
-        self.start_orbit(self.shown.positions[ball], ball)
-
-    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        self.panel.backend.mouse_button(x, y, button, False)
-        self.screen.release()
-        if button == mouse.LEFT:
-            self.command(lambda sim: self.interaction.release())
-
-    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        self.panel.backend.mouse_motion(x, y)
-        if self.panel.backend.wants_mouse:  # a drag that started on the panel
-            return
-        if buttons & mouse.LEFT and self.screen.drag(x, y):
-            return
-        if buttons & mouse.LEFT:
-            self.interaction.move(x, y)
-            if self.orbit.active and self.interaction.held_ball is None:
-                self.orbit.turn(self.camera, dx, dy)
-        if buttons & mouse.MIDDLE and self.orbit.active:
-            self.orbit.pan(self.camera, dx, dy, self.window.height)
-        if buttons & mouse.RIGHT or self.mouse_captured:
-            if self.orbit.active:
-                self.orbit.turn(self.camera, dx, dy)
-            else:
-                self.camera.look(dx, dy)
-
-    def on_mouse_motion(self, x: int, y: int, dx: int, dy: int) -> None:
-        self.panel.backend.mouse_motion(x, y)
-        if self.mouse_captured:
-            self.camera.look(dx, dy)
-
-    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
-        self.panel.backend.scroll(x, y, scroll_x, scroll_y)
-        if self.panel.covers(x, y):
-            return
-        if self.orbit.active:
-            self.orbit.zoom(self.camera, scroll_y)
-        else:
-            self.camera.speed = controls.scrolled_fly_speed(self.camera.speed, scroll_y)
-
     def on_resize(self, width: int, height: int) -> None:
         self.panel.backend.resize()
         self.hud.layout()  # pyglet's own handler (viewport, HUD projection) runs after this one
@@ -505,13 +334,7 @@ class Viewer:
         now = time.perf_counter()
         elapsed = now - self._last_frame if dt is None else dt
         self._last_frame = now
-        if self.orbit.active:
-            if self.orbit.follow is not None and self.orbit.follow < self.shown.ball_count:
-                self.orbit.carry(self.camera, self.shown.positions[self.orbit.follow])
-        else:
-            self.camera.fly(
-                controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
-            )
+        self.view.move(self.held, elapsed)
         self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
             self._watch_at = now + WATCH_INTERVAL
@@ -619,32 +442,13 @@ class Viewer:
             self.window.set_caption(title(shown.appearance.name, self.fps))
 
     def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
-        """Save the back buffer (what this frame drew, HUD included) as a PNG in ``directory``
-        (``screenshots/`` in the current directory, created if need be); prints the path and shows it
-        in the HUD."""
-        import numpy as np
-        from OpenGL import GL
-        from PIL import Image
+        """Save the back buffer (what this frame drew, panel and HUD included) as a PNG (screenshot.py);
+        prints the path and shows it in the HUD."""
+        from .screenshot import save_screenshot
 
-        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
-        GL.glReadBuffer(GL.GL_BACK)
-        data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
-        image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
-        directory = Path.cwd() / SCREENSHOT_DIRECTORY if directory is None else directory
-        directory.mkdir(parents=True, exist_ok=True)
-        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-        path = directory / f"ballpit-{stamp}.png"
-        n = 1
-        while path.exists():
-            n += 1
-            path = directory / f"ballpit-{stamp}-{n}.png"
-        Image.fromarray(image).save(path)
-        self.last_screenshot = path.resolve()
+        self.last_screenshot = save_screenshot(width, height, directory)
         print(f"screenshot saved to {self.last_screenshot}", flush=True)
-        shown = self.last_screenshot
-        if shown.is_relative_to(Path.cwd()):
-            shown = shown.relative_to(Path.cwd())
-        self.hud.flash(f"screenshot saved to {shown}", time.perf_counter())
+        self.hud.flash(f"screenshot saved to {_near(self.last_screenshot)}", time.perf_counter())
         return self.last_screenshot
 
     def sync(self) -> None:
@@ -687,6 +491,11 @@ class Viewer:
         # schedule_once counts from the loop's tick (clock.last_ts) unless that is 0.2 s old
         base = now if clock.last_ts is None or now - clock.last_ts > 0.2 else clock.last_ts
         clock.schedule_once(self._redraw, max(self._due - base, 0.0))
+
+
+def _near(path: Path) -> Path:
+    """``path`` relative to the current directory when it is under it (as the HUD says it)."""
+    return path.relative_to(Path.cwd()) if path.is_relative_to(Path.cwd()) else path
 
 
 def _gl_renderer() -> str:

@@ -587,7 +587,7 @@ class Panel:
         self._remember("camera free")
         imgui.same_line()
         if imgui.radio_button("orbit", orbit.active) and not orbit.active:
-            v.start_orbit()
+            v.view.start_orbit()
         self._remember("camera orbit")
         changed, orbit.follow_wanted = imgui.checkbox("follow the ball orbited", orbit.follow_wanted)
         if changed and not orbit.follow_wanted:
