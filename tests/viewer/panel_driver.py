@@ -120,6 +120,8 @@ def scene_list(workdir: Path) -> dict:
         "phase": sim.phase.name,
         "camera": viewer.camera.position.tolist(),
         "scene_camera": look.camera_position.tolist(),
+        "look_at": look.camera_look_at.tolist(),
+        "forward": viewer.camera.forward.tolist(),
         "title": viewer.window.caption,
         "recent": [p.name for p in viewer.panel.recent],
     }
