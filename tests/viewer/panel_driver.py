@@ -189,7 +189,12 @@ def restitution_edit(workdir: Path) -> dict:
     out["phase"] = sim.phase.name
     image = grab(viewer)
     out["error_red"] = red_pixels(image, viewer.panel.rects["error ball.radius"])
-    out["field_text_after"] = viewer.panel.rects.get("ball.radius") is not None
+    press(viewer, "P", frames=10)  # the plots: the energy, and the selected ball's height and speed
+    out["plots"] = [key for key in ("plot area energy", "plot area ball") if key in viewer.panel.rects]
+    image = grab(viewer)
+    x, y, w, h = viewer.panel.rects["plot area ball"]
+    region = image[int(y) : int(y + h), int(x) : int(x + w)]
+    out["apex_marker"] = int(((region[..., 1] > 150) & (region[..., 0] < 120) & (region[..., 2] < 120)).sum())
     return out
 
 

@@ -65,6 +65,9 @@ def test_a_nan_typed_into_a_field_is_refused_beside_it_the_value_stays_and_the_r
     assert r["radius"] == 0.25
     assert r["phase"] == "RUNNING" and r["ran_on"] > 0.1
     assert r["error_red"] > 50  # drawn in red under the field
+    # P opens the plots; the selected ball's height shows its apexes marked
+    assert r["plots"] == ["plot area energy", "plot area ball"]
+    assert r["apex_marker"] > 10
 
 
 def test_a_scene_dropped_on_the_window_opens_and_a_broken_one_keeps_the_current_scene(xvfb, tmp_path):

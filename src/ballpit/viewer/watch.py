@@ -123,10 +123,8 @@ class Traces:
     def copy(self) -> TraceCopy:
         if not self.samples:
             return TraceCopy(ball=self.ball)
-        data = np.array(self.samples, dtype=float)
-        return TraceCopy(
-            time=data[:, 0], contacts=data[:, 1], height=data[:, 2], speed=data[:, 3], ball=self.ball
-        )
+        data = np.array(self.samples, dtype=float).T.copy()  # rows: ImPlot takes contiguous arrays
+        return TraceCopy(time=data[0], contacts=data[1], height=data[2], speed=data[3], ball=self.ball)
 
 
 def world_facts(sim: Simulation) -> WorldFacts:
