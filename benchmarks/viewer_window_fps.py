@@ -199,7 +199,8 @@ def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: di
     """One viewer process on ``scene`` (or, ``headless``, its landing stepped with no window); returns
     its measurements."""
     command = [sys.executable, "-c", CHILD, scene, str(args.seconds), args.quality,
-               "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land), args.panel]  # fmt: skip
+               "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land)]  # fmt: skip
+    command.append(args.panel)
     if headless:
         command = [sys.executable, "-c", HEADLESS, scene, str(args.land)]
     proc = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
