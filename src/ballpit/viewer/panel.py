@@ -461,18 +461,19 @@ class Panel:
         imgui.text("position  " + "  ".join(f"{v:7.3f}" for v in b.position))
         imgui.text(f"speed {speed:.3f} m/s   spin {np.sqrt((b.spin * b.spin).sum()):.3f} rad/s")
         imgui.text(f"kinetic {b.kinetic:.4g} J   potential {b.potential:.4g} J")
-        for name in ("radius", "mass", "restitution", "friction", "rolling_friction"):
-            self._number(
-                name.replace("_", " "),
-                f"ball.{name}",
-                getattr(b, name),
-                lambda v, n=name: self.edits.ball(i, n, v),
-            )
+        self._numbers("ball", b, ("radius", "mass", "restitution", "friction", "rolling_friction"))
         self._vector("velocity", "ball.velocity", b.velocity, lambda v: self.edits.ball(i, "velocity", v))
         if imgui.button("Delete ball"):
             self.edits.remove_ball(i, lambda _: self.viewer.select(None))
         self._remember("Delete ball")
         self._error("ball.remove")
+
+    def _numbers(self, kind: str, facts: BallFacts | PlaneFacts, names: tuple[str, ...]) -> None:
+        """One typed field per number ``names`` of the selected ball or plane."""
+        edit = self.edits.ball if kind == "ball" else self.edits.plane
+        for name in names:
+            send = lambda v, n=name: edit(facts.index, n, v)  # noqa: E731
+            self._number(name.replace("_", " "), f"{kind}.{name}", getattr(facts, name), send)
 
     def _plane(self, p: PlaneFacts) -> None:
         i = p.index
@@ -485,13 +486,7 @@ class Panel:
         self._vector(
             "angles °", "plane.rotation", p.rotation, lambda v: self.edits.plane(i, "rotation", v), "%.2f"
         )
-        for name in ("restitution", "friction", "rolling_friction"):
-            self._number(
-                name.replace("_", " "),
-                f"plane.{name}",
-                getattr(p, name),
-                lambda v, n=name: self.edits.plane(i, n, v),
-            )
+        self._numbers("plane", p, ("restitution", "friction", "rolling_friction"))
         self._vector("velocity", "plane.velocity", p.velocity, lambda v: self.edits.plane(i, "velocity", v))
         self._vector(
             "spin",

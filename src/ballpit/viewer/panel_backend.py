@@ -60,20 +60,14 @@ class _Renderer(PygletProgrammablePipelineRenderer):
         gl.glBindVertexArray(self._vao_handle)
         index_type = gl.GL_UNSIGNED_SHORT if imgui.INDEX_SIZE == 2 else gl.GL_UNSIGNED_INT
         for commands in draw_data.cmd_lists:
-            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self._vbo_handle)
-            gl.glBufferData(
-                gl.GL_ARRAY_BUFFER,
-                commands.vtx_buffer.size() * imgui.VERTEX_SIZE,
-                ctypes.c_void_p(commands.vtx_buffer.data_address()),
-                gl.GL_STREAM_DRAW,
-            )
-            gl.glBindBuffer(gl.GL_ELEMENT_ARRAY_BUFFER, self._elements_handle)
-            gl.glBufferData(
-                gl.GL_ELEMENT_ARRAY_BUFFER,
-                commands.idx_buffer.size() * imgui.INDEX_SIZE,
-                ctypes.c_void_p(commands.idx_buffer.data_address()),
-                gl.GL_STREAM_DRAW,
-            )
+            for target, handle, data, size in (
+                (gl.GL_ARRAY_BUFFER, self._vbo_handle, commands.vtx_buffer, imgui.VERTEX_SIZE),
+                (gl.GL_ELEMENT_ARRAY_BUFFER, self._elements_handle, commands.idx_buffer, imgui.INDEX_SIZE),
+            ):
+                gl.glBindBuffer(target, handle)
+                gl.glBufferData(
+                    target, data.size() * size, ctypes.c_void_p(data.data_address()), gl.GL_STREAM_DRAW
+                )
             for command in commands.cmd_buffer:
                 gl.glBindTexture(gl.GL_TEXTURE_2D, command.tex_ref.get_tex_id())
                 x, y, z, w = command.clip_rect

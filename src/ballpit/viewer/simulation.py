@@ -266,16 +266,8 @@ class Simulation:
             self.error = "no scene file to reload (this world was built in code)"
             return False
         self._signature = _file_signature(self.path)
-        try:
-            scene = self.loader(self.path)
-        except Exception as exc:  # any failure: the viewer must stay up with the old world
-            self.error = f"reload of {self.path.name} failed: {_describe(exc)}"
-            print(f"ballpit: {self.error} (keeping the last good scene)", file=sys.stderr, flush=True)
-            return False
-        self._install(scene)
-        self.error = None
-        self.message = f"reloaded {self.path.name}: press X to drop"
-        return True
+        name = self.path.name
+        return self._load(self.path, f"reload of {name} failed", f"reloaded {name}", "the last good scene")
 
     def file_changed(self) -> bool:
         """True once each time the scene file's modification time or size changes."""
@@ -390,15 +382,20 @@ class Simulation:
         """Open another scene file in place of this one; on any error keep the scene running and
         remember the error (as a failed reload does)."""
         path = Path(path)
+        return self._load(path, f"cannot open {path.name}", f"opened {path.name}", "the current scene")
+
+    def _load(self, path: Path, failed: str, done: str, kept: str) -> bool:
+        """Put the scene file ``path`` in place of the world; on any error keep the world running and
+        say ``failed`` (with the reason) in ``error`` and on stderr."""
         try:
             scene = self.loader(path)
         except Exception as exc:  # any failure: the viewer must stay up with the old world
-            self.error = f"cannot open {path.name}: {_describe(exc)}"
-            print(f"ballpit: {self.error} (keeping the current scene)", file=sys.stderr, flush=True)
+            self.error = f"{failed}: {_describe(exc)}"
+            print(f"ballpit: {self.error} (keeping {kept})", file=sys.stderr, flush=True)
             return False
         self._install(scene)
         self.error = None
-        self.message = f"opened {path.name}: press X to drop"
+        self.message = f"{done}: press X to drop"
         return True
 
     def add_ball(self, color: object, **kwargs: object) -> int:
