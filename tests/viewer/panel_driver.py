@@ -189,6 +189,9 @@ def restitution_edit(workdir: Path) -> dict:
     out["phase"] = sim.phase.name
     image = grab(viewer)
     out["error_red"] = red_pixels(image, viewer.panel.rects["error ball.radius"])
+    type_into(viewer, "ball.mass", "1.5")  # "1" is Euler's key: typed into a field, it is only text
+    out["integrator_after_typing"] = sim.world.integrator
+    out["mass"] = sim.world.spheres[0].mass
     press(viewer, "P", frames=10)  # the plots: the energy, and the selected ball's height and speed
     out["plots"] = [key for key in ("plot area energy", "plot area ball") if key in viewer.panel.rects]
     image = grab(viewer)

@@ -65,6 +65,8 @@ def test_a_nan_typed_into_a_field_is_refused_beside_it_the_value_stays_and_the_r
     assert r["radius"] == 0.25
     assert r["phase"] == "RUNNING" and r["ran_on"] > 0.1
     assert r["error_red"] > 50  # drawn in red under the field
+    # keys typed into a field are the field's: "1" (Euler's key) typed into the mass is only a digit
+    assert r["integrator_after_typing"] == "rk4" and r["mass"] == 1.5
     # P opens the plots; the selected ball's height shows its apexes marked
     assert r["plots"] == ["plot area energy", "plot area ball"]
     assert r["apex_marker"] > 10
