@@ -209,3 +209,23 @@ def test_the_orbit_camera_turns_about_its_target_zooms_towards_it_and_pans_with_
     assert orbit.follow == 3
     orbit.carry(camera, (2.0, 1.0, 1.0))
     assert np.allclose(orbit.target, (2.0, 1.0, 1.0))
+
+
+def test_a_replay_refuses_edits_and_plays_on(tmp_path):
+    from ballpit.viewer.replay import read_trajectory
+    from ballpit.writers import TrajectoryWriter
+
+    sim = bounce_sim()
+    out = tmp_path / "run.npz"
+    writer = TrajectoryWriter(out, 1)
+    world = sim.world.copy()
+    for _ in range(10):
+        b = world.spheres
+        writer.record(world.time, b.positions, b.velocities, b.angular_velocities, b.orientations)
+        world.step(1 / 240)
+    writer.commit()
+    replay = Simulation(bounce_sim().world, trajectory=read_trajectory(out, n_balls=1))
+    edits = Edits(run_now(replay))
+    edits.ball(0, "restitution", 0.5)
+    assert edits.error("ball.restitution") == "a replay plays a recorded run: it cannot be edited"
+    assert replay.world.spheres[0].restitution == 1.0

@@ -363,7 +363,10 @@ class Simulation:
         """A change by hand between steps: ``change(world)`` (a World method that refuses bad values
         with ValueError/TypeError and then changes nothing). The history keeps the changed state as the
         present (re-stepping starts from it; any later steps are dropped) and, with ``ghosts``, each
-        ghost gets the same change, so an edited run is recorded and compared as what it is."""
+        ghost gets the same change, so an edited run is recorded and compared as what it is. A replay
+        refuses (ValueError): it writes the recorded frames into the world."""
+        if self.timeline.replay is not None:
+            raise ValueError("a replay plays a recorded run: it cannot be edited")
         result = change(self.world)
         self.timeline.edited(change if ghosts else None)
         return result
