@@ -19,7 +19,9 @@ Per scene, medians over the runs of:
   thread, the window's (main) thread, llvmpipe's rasteriser threads and the rest;
 - with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end;
 - ``panel_ms_before`` and ``panel_ms_land``: the mean time the panel took per frame (building it with
-  ImGui and handing its triangles to GL, on the window's thread) before X and while the scene lands.
+  ImGui and handing its triangles to GL, on the window's thread) before X and while the scene lands;
+  ``panel_cpu_ms_*`` the same in the window thread's CPU time (without the waits for the GIL and for a
+  core that the wall time holds while the physics thread runs).
   ``--panel off`` opens the viewer with the panel hidden (F4), for a paired comparison of frame rates.
 
 ``--env NAME=VALUE`` sets a variable for the child before anything loads (LP_NUM_THREADS, ...); the
@@ -116,7 +118,9 @@ def tick(_dt):
         frames, _, t = state["mark"]
         out["fps_before_x"] = (viewer.frames - frames) / (now - t)
         out["panel_ms_before"] = viewer.panel.cost_ms() if panel else None
+        out["panel_cpu_ms_before"] = viewer.panel.cost_ms(cpu=True) if panel else None
         viewer.panel.seconds.clear()
+        viewer.panel.cpu_seconds.clear()
         viewer.window.dispatch_event("on_key_press", key.X, 0)
         idle = getattr(viewer.physics, "idle_seconds", 0.0)
         captured = getattr(viewer.physics, "capture_seconds", 0.0)
@@ -132,6 +136,7 @@ def tick(_dt):
             wall = now - t
             out["land_fps"] = (viewer.frames - frames) / wall
             out["panel_ms_land"] = viewer.panel.cost_ms() if panel else None
+            out["panel_cpu_ms_land"] = viewer.panel.cost_ms(cpu=True) if panel else None
             out["land_rtf"] = simulated / wall
             samples = [s for s in state["samples"] if s is not None]
             out["hud_rtf"] = statistics.median(samples) if samples else None
@@ -190,6 +195,7 @@ print("RESULT " + json.dumps({"land_rtf": world.time / wall, "physics_cpu_per_si
 
 COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fps_after_x",
            "steps_per_second", "real_time_factor", "panel_ms_before", "panel_ms_land"]  # fmt: skip
+COLUMNS += ["panel_cpu_ms_before", "panel_cpu_ms_land"]
 THREAD_COLUMNS = ["cpu_physics", "cpu_main", "cpu_llvmpipe", "cpu_other", "physics_cpu_per_sim_s",
                   "cpu_physics_queued", "physics_asleep", "physics_idle", "physics_capture"]  # fmt: skip
 

@@ -87,7 +87,10 @@ class Panel:
         self.path_text = ""
         self._dialog: object = None
         self._dialog_kind = ""
-        self.seconds: deque[float] = deque(maxlen=240)  # building and drawing the panel, per frame
+        # building and drawing the panel, per frame: wall time, and the window thread's own CPU time (the
+        # wall time also holds the waits for the GIL and for a core while the physics thread runs)
+        self.seconds: deque[float] = deque(maxlen=240)
+        self.cpu_seconds: deque[float] = deque(maxlen=240)
         self._window = (0.0, 0.0, 0.0, 0.0)
         self._bundled = [path.resolve() for path in bundled_scenes()]
         self._prompt_key: tuple = ()
@@ -130,13 +133,15 @@ class Panel:
         """Whether the physics side should copy the traces at hand-over."""
         return self.shown and self.sections["Plots"] and any(self.plots.values())
 
-    def cost_ms(self) -> float:
-        """The mean time the panel took to build and draw over the recent frames, ms."""
-        return 1e3 * float(np.mean(self.seconds)) if self.seconds else 0.0
+    def cost_ms(self, cpu: bool = False) -> float:
+        """The mean time the panel took to build and draw over the recent frames, ms (``cpu``: the
+        window thread's CPU time)."""
+        kept = self.cpu_seconds if cpu else self.seconds
+        return 1e3 * float(np.mean(kept)) if kept else 0.0
 
     # ------------------------------------------------------------------ the frame
     def draw(self, shown: Shown) -> None:
-        started = time.perf_counter()
+        started, cpu = time.perf_counter(), time.thread_time()
         self.backend.new_frame()
         watch: Watch | None = shown.watch
         if self.shown and watch is not None:
@@ -148,6 +153,7 @@ class Panel:
         self._poll_dialog()
         self.backend.render()
         self.seconds.append(time.perf_counter() - started)
+        self.cpu_seconds.append(time.thread_time() - cpu)
 
     def _remember(self, key: str) -> None:
         lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
