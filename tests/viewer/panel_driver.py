@@ -246,7 +246,53 @@ def add_ball(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (scene_list, drop_buttons, restitution_edit, file_drop, add_ball)}
+def orbit(workdir: Path) -> dict:
+    """Double-click the ball: the camera orbits it; the wheel zooms towards it; a right drag turns
+    about it; Home goes back to the scene's view, flying free."""
+    viewer = panel_viewer(workdir, BOUNCE_SCENE)
+    sim = viewer.sim
+    centre = np.array(sim.world.spheres[0].position)
+    pixels, _ = viewer.camera.project(centre[None, :], *SIZE)
+    wid = str(viewer.window._window)
+    xdotool("mousemove", "--window", wid, str(int(pixels[0, 0])), str(int(pixels[0, 1])))
+    settle(viewer, 2)
+    xdotool("click", "--repeat", "2", "--delay", "60", "1")
+    wait_for(viewer, lambda: viewer.orbit.active, frames=60)
+    out: dict = {
+        "active": viewer.orbit.active,
+        "centre": centre.tolist(),
+        "position": sim.world.spheres[0].position.tolist(),
+    }
+    out["target"] = viewer.orbit.target.tolist() if viewer.orbit.active else None
+    out["distance"] = viewer.orbit.distance(viewer.camera)
+    xdotool("click", "4")  # the wheel, one notch up
+    settle(viewer, 4)
+    out["zoomed"] = viewer.orbit.distance(viewer.camera)
+    yaw = viewer.camera.yaw
+    xdotool("mousedown", "3")
+    for k in range(1, 6):
+        xdotool("mousemove", "--window", wid, str(int(pixels[0, 0]) + 20 * k), str(int(pixels[0, 1])))
+        settle(viewer, 1)
+    xdotool("mouseup", "3")
+    settle(viewer, 3)
+    out["turned"] = viewer.camera.yaw - yaw
+    out["looks_at_target"] = float(
+        np.linalg.norm(
+            viewer.camera.position
+            + viewer.camera.forward * viewer.orbit.distance(viewer.camera)
+            - viewer.orbit.target
+        )
+    )
+    press(viewer, "HOME", frames=2)
+    out["after_home"] = [
+        viewer.orbit.active,
+        viewer.camera.position.tolist(),
+        sim.appearance.camera_position.tolist(),
+    ]
+    return out
+
+
+SCENARIOS = {f.__name__: f for f in (scene_list, drop_buttons, restitution_edit, file_drop, add_ball, orbit)}
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ import pytest
 from .conftest import run_driver
 
 DRIVER = Path(__file__).with_name("panel_driver.py")
-BATCH = ("scene_list", "drop_buttons", "restitution_edit", "file_drop", "add_ball")
+BATCH = ("scene_list", "drop_buttons", "restitution_edit", "file_drop", "add_ball", "orbit")
 pytestmark = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
 
@@ -90,3 +90,14 @@ def test_a_ball_is_added_where_the_pointer_clicks_and_one_inside_it_is_refused(x
     assert np.hypot(x - 1.5, z - 0.5) < 0.05  # where the pointer was
     assert r["count_again"] == 2
     assert "would overlap ball 1" in r["error"]
+
+
+def test_a_double_clicked_ball_is_orbited_the_wheel_zooms_a_drag_turns_and_home_flies_again(xvfb, tmp_path):
+    r = run_scenario(xvfb, "orbit", tmp_path)
+    assert r["active"] and r["position"] == r["centre"]  # a double-click does not move the ball
+    assert np.allclose(r["target"], r["centre"])
+    assert r["zoomed"] == pytest.approx(r["distance"] * 0.85, rel=1e-9)
+    assert abs(r["turned"]) > 0.1  # turned about the ball...
+    assert r["looks_at_target"] < 1e-9  # ...still looking at it
+    active, eye, filed = r["after_home"]
+    assert not active and np.allclose(eye, filed)  # the scene's view (it has a ground), flying free
