@@ -20,7 +20,7 @@ from dataclasses import dataclass, fields
 
 from .pairs import PairCache
 from .resting import WarmStart
-from .state import State
+from .state import SavedState, State
 
 
 @dataclass
@@ -42,16 +42,22 @@ _PARTS = tuple(f.name for f in fields(Parts))
 
 @dataclass(frozen=True)
 class Checkpoint:
-    """Every part of a world as it was at one moment (``saved``: each part's ``checkpoint()``)."""
+    """Every part of a world as it was at one moment: ``saved`` holds each part's ``checkpoint()`` by
+    its name in ``Parts``."""
 
-    saved: Parts
+    saved: dict[str, object]
 
     @staticmethod
     def of(parts: Parts) -> Checkpoint:
         """The parts as they are now."""
-        return Checkpoint(Parts(*[getattr(parts, name).checkpoint() for name in _PARTS]))
+        return Checkpoint({name: getattr(parts, name).checkpoint() for name in _PARTS})
+
+    @property
+    def state(self) -> SavedState:
+        """The state as it was: the balls' (N, 13) block, the planes' poses, the time, sleep."""
+        return self.saved["state"]
 
     def restore(self, parts: Parts) -> None:
         """Put every part back as it was (the checkpoint stays usable: it can be restored again)."""
         for name in _PARTS:
-            getattr(parts, name).restore(getattr(self.saved, name))
+            getattr(parts, name).restore(self.saved[name])

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from .checkpoint import Checkpoint
 from .model import Model
+from .state import SavedState
 
 
 @dataclass(frozen=True)
@@ -16,3 +17,8 @@ class Snapshot:
     model: Model
     checkpoint: Checkpoint
     crowded_steps: int
+
+    @property
+    def state(self) -> SavedState:
+        """The state as it was: the balls' (N, 13) block, the planes' poses, the time, sleep."""
+        return self.checkpoint.state

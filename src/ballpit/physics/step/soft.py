@@ -109,7 +109,7 @@ def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c:
     overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    body_before = checkpoint.saved.state.body  # the balls as the frame found them
+    body_before = checkpoint.state.body  # the balls as the frame found them
     frame = softstep.frame(
         model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps, step.profile
     )
