@@ -12,50 +12,26 @@ import copy
 
 import numpy as np
 
-from . import collision, energy, exact, moving_planes, quaternion, validation
+from . import edits, energy, moving_planes, validation
 from . import step as pipeline
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .checkpoint import Checkpoint, Parts
 from .contacts import ContactRecord
 from .forces import ForceTerm
-from .integrators import INTEGRATORS, Workspace
+from .integrators import Workspace
 from .model import (
     BALL_MASS,
     BALL_RADIUS,
     BALL_RESTITUTION,
     FRICTION,
-    HOLLOW_INERTIA,
     PLANE_RESTITUTION,
     ROLLING_FRICTION,
-    SOLID_INERTIA,
     Model,
 )
-from .pairs import PairCache
+from .parameters import Count, Flag, Integrator, Number, Vector
 from .profile import StepProfile
-from .resting import WarmStart
 from .snapshot import Snapshot
 from .state import Q, State, V, W, X
-
-
-def _index(kind: str, index: object, count: int) -> int:
-    """``index`` checked as the index of one of ``count`` balls or planes (TypeError/ValueError naming it)."""
-    if isinstance(index, bool) or not isinstance(index, int | np.integer):
-        raise TypeError(f"index must be a {kind}'s index, got {index!r}")
-    if not 0 <= index < count:
-        raise ValueError(f"index must be a {kind}'s index from 0 to {count - 1}, got {index}")
-    return int(index)
-
-
-def _model_number(name: str, doc: str, **checks: bool) -> property:
-    """A World parameter stored in the model, validated on the way in."""
-
-    def get(self: World) -> float:
-        return getattr(self.model, name)
-
-    def set(self: World, value: float) -> None:
-        setattr(self.model, name, validation.number(name, value, **checks))
-
-    return property(get, set, doc=doc)
 
 
 class World:
@@ -103,88 +79,37 @@ class World:
     def time(self, value: float) -> None:
         self.state.time = validation.number("time", value)
 
-    @property
-    def gravity(self) -> np.ndarray:
-        """Gravity (m/s²), read-only: assign a whole vector to change it (each component at most
-        ``validation.MAX_GRAVITY``, 1e9 m/s², in size)."""
-        view = self.model.gravity.view()
-        view.flags.writeable = False
-        return view
-
-    @gravity.setter
-    def gravity(self, value: object) -> None:
-        self.model.gravity = validation.vector("gravity", value, limit=validation.MAX_GRAVITY)
-
-    @property
-    def integrator(self) -> str:
-        """One of ``INTEGRATOR_NAMES`` ("euler", "rk2", "rk4", "symplectic"); may be changed between steps."""
-        return self.model.integrator.name
-
-    @integrator.setter
-    def integrator(self, value: str) -> None:
-        if not isinstance(value, str) or value.lower() not in INTEGRATORS:
-            raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {value!r}")
-        self.model.integrator = INTEGRATORS[value.lower()]
-
-    linear_drag = _model_number("linear_drag", "Linear drag c (1/s): acceleration −c·v.", nonnegative=True)
-    angular_drag = _model_number(
-        "angular_drag", "Angular drag c_ω (1/s): angular acceleration −c_ω·ω.", nonnegative=True
+    gravity = Vector(
+        "Gravity (m/s²), read-only: assign a whole vector to change it (each component at most "
+        "``validation.MAX_GRAVITY``, 1e9 m/s², in size).",
+        limit=validation.MAX_GRAVITY,
     )
-
-    @property
-    def solver_iterations(self) -> int:
-        """Projected Gauss–Seidel sweeps per contact solve (at least 1)."""
-        return self.model.solver_iterations
-
-    @solver_iterations.setter
-    def solver_iterations(self, value: int) -> None:
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise ValueError(f"solver_iterations must be a whole number of at least 1, got {value!r}")
-        self.model.solver_iterations = int(value)
-
-    @property
-    def substeps(self) -> int:
-        """Soft substeps per crowded step (Box2D v3's soft step, softstep.py): a crowded step's contacts
-        are solved this many times, each over dt / substeps. The split-at-impacts path ignores it."""
-        return self.model.substeps
-
-    @substeps.setter
-    def substeps(self, value: int) -> None:
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise ValueError(f"substeps must be a whole number of at least 1, got {value!r}")
-        self.model.substeps = int(value)
-
-    crowd_limit = _model_number(
-        "crowd_limit",
+    integrator = Integrator(
+        'One of ``INTEGRATOR_NAMES`` ("euler", "rk2", "rk4", "symplectic"); may be changed between steps.'
+    )
+    linear_drag = Number("Linear drag c (1/s): acceleration −c·v.", nonnegative=True)
+    angular_drag = Number("Angular drag c_ω (1/s): angular acceleration −c_ω·ω.", nonnegative=True)
+    solver_iterations = Count("Projected Gauss–Seidel sweeps per contact solve (at least 1).")
+    substeps = Count(
+        "Soft substeps per crowded step (Box2D v3's soft step, softstep.py): a crowded step's contacts "
+        "are solved this many times, each over dt / substeps. The split-at-impacts path ignores it."
+    )
+    crowd_limit = Number(
         "A step in which more pairs than this may meet is taken whole, with speculative contacts "
         "(inf: always split the step at each impact; 0: take every step with an impact whole). "
         "Among 256 kept pairs or more (a pile) any meeting does, unless this is inf.",
         nonnegative=True,
         infinite=True,
     )
-
-    @property
-    def restitution_threshold(self) -> float | None:
-        """Approach speed (m/s) below which contacts do not bounce; None picks one from g and dt."""
-        return self.model.restitution_threshold
-
-    @restitution_threshold.setter
-    def restitution_threshold(self, value: float | None) -> None:
-        if value is not None:
-            value = validation.number("restitution_threshold", value, nonnegative=True)
-        self.model.restitution_threshold = value
-
-    @property
-    def sleep(self) -> bool:
-        """Whether balls that have stayed still together for half a second fall asleep (cost nothing,
-        move not at all) until something reaches them (sleeping.py). Off by default."""
-        return self.model.sleep
-
-    @sleep.setter
-    def sleep(self, value: bool) -> None:
-        if not isinstance(value, bool | np.bool_):
-            raise TypeError(f"sleep must be true or false, got {value!r}")
-        self.model.sleep = bool(value)
+    restitution_threshold = Number(
+        "Approach speed (m/s) below which contacts do not bounce; None picks one from g and dt.",
+        optional=True,
+        nonnegative=True,
+    )
+    sleep = Flag(
+        "Whether balls that have stayed still together for half a second fall asleep (cost nothing, "
+        "move not at all) until something reaches them (sleeping.py). Off by default."
+    )
 
     @property
     def asleep(self) -> np.ndarray:
@@ -298,72 +223,27 @@ class World:
         self._remember_planes()
         return Plane(self, i)
 
-    # ------------------------------------------------------------------ edits between steps
+    # ------------------------------------------------------------------ edits between steps (edits.py)
     def set_sphere_size(self, index: int, radius: float | None = None, mass: float | None = None) -> None:
         """Give ball ``index`` a new ``radius`` and/or ``mass``; its inverse mass and inertia follow
         (2/5·m·r² solid, 2/3·m·r² hollow). Both are checked before either is written."""
-        i = self._ball_index(index)
-        cols = self.model.spheres
-        r = cols.radius[i] if radius is None else validation.number("radius", radius, positive=True)
-        m = cols.mass[i] if mass is None else validation.number("mass", mass, positive=True)
-        cols.radius[i], cols.mass[i] = r, m
-        cols.inv_mass[i] = 1.0 / m
-        shape_factor = HOLLOW_INERTIA if cols.hollow[i] else SOLID_INERTIA
-        cols.inv_inertia[i] = 1.0 / (shape_factor * m * r * r)
-        self._edited()
+        edits.set_sphere_size(self.model, self.parts, index, radius, mass)
 
     def remove_sphere(self, index: int) -> None:
         """Remove ball ``index``; the balls after it move down one index."""
-        i = self._ball_index(index)
-        self.model.spheres.remove(i)
-        self.state.remove(i)
-        self._edited()
+        edits.remove_sphere(self.model, self.parts, index)
 
     def move_plane(self, index: int, position: object = None, rotation: object = None) -> None:
         """Put plane ``index``'s centre at ``position`` and/or turn it to ``rotation`` (extrinsic x, y, z
         degrees from the +y plane, as ``add_plane``). Both are checked before either is written."""
-        index = _index("plane", index, self.model.planes.count)
-        pose = self.state.planes
-        limit = validation.MAX_COORDINATE
-        center = None if position is None else validation.vector("position", position, limit=limit)
-        q = None if rotation is None else quaternion.from_euler_xyz(validation.vector("rotation", rotation))
-        if center is not None:
-            pose.center[index] = center
-        if q is not None:
-            moving_planes.set_orientation(pose, index, q)
+        edits.move_plane(self.model, self.parts, index, position, rotation)
         self._remember_planes()
-        self._edited()
-
-    def _ball_index(self, index: object) -> int:
-        return _index("ball", index, self.state.count)
 
     def first_overlap(self, position: object, radius: float) -> str | None:
         """What a ball of ``radius`` at ``position`` would overlap ("ball 3", "plane 0"), or None: the
         check a ball added by hand should pass (``add_sphere`` itself allows overlaps, which the step
         pushes apart)."""
-        p = validation.vector("position", position, limit=validation.MAX_COORDINATE)
-        r = validation.number("radius", radius, positive=True)
-        balls = self.state.body[:, X] - p
-        reach = self.model.spheres.radius + r
-        hit = np.flatnonzero(exact.dot(balls, balls) < reach * reach)
-        if hit.size:
-            return f"ball {hit[0]}"
-        pose, shape = self.state.planes, self.model.planes
-        k = np.arange(shape.count)
-        points = np.broadcast_to(p, (shape.count, 3))
-        near = collision.closest_point_on_planes(
-            points, k, pose.center, pose.axis_u, pose.axis_v, shape.half_size
-        )
-        gap = near - points
-        hit = np.flatnonzero(exact.dot(gap, gap) < r * r)
-        return f"plane {hit[0]}" if hit.size else None
-
-    def _edited(self) -> None:
-        """Something a step reads was changed by hand: the kept pairs and warm start are found afresh,
-        and sleeping balls wake."""
-        self.parts.pairs = PairCache()
-        self.parts.warm = WarmStart()
-        self.state.sleep.wake_all()
+        return edits.first_overlap(self.model, self.state, position, radius)
 
     def _remember_planes(self) -> None:
         """Copy the plane columns, to put back a bad value written into them before the next step."""
