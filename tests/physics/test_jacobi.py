@@ -89,19 +89,6 @@ def test_a_falling_column_is_never_pushed_upwards_while_it_is_stopped():
         assert v[:n, 1].max() <= 1e-15
 
 
-def test_separation_puts_an_overlapping_column_exactly_touching():
-    n = 20
-    rows = column(n)
-    squeeze = 0.01  # every contact overlaps by 1 cm
-    y = R + np.arange(n) * (2 * R - squeeze)
-    pos = np.zeros((n + 1, 3))
-    pos[:n, 1] = y
-    gap = np.r_[y[0] - R, np.diff(y) - 2 * R]
-    jacobi.separate(rows.a, rows.b, rows.normal, gap, rows.inv_mass_a, rows.inv_mass_b, pos, 20_000)
-    assert pos[:n, 1] == pytest.approx(R + 2 * R * np.arange(n), abs=1e-9)  # the floor does not move
-    assert np.abs(pos[:n, [0, 2]]).max() == 0.0
-
-
 def landing_on_one_ball(k: int) -> ContactRows:
     """k balls (0 … k−1) landing at once on ball k, which sits on the floor (static row k + 1); the
     last contact holds ball k on the floor."""

@@ -28,6 +28,7 @@ sum over x, y, z is taken from first to last, so each solve gives the same bits 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +46,26 @@ class Impulses:
     @staticmethod
     def zeros(count: int) -> Impulses:
         return Impulses(np.zeros(count), np.zeros((count, 3)), np.zeros((count, 3)))
+
+
+@dataclass(frozen=True)
+class Softness:
+    """A soft constraint's coefficients for a substep h (softstep.py's docstring has the formulas)."""
+
+    bias_rate: float
+    mass_scale: float
+    impulse_scale: float
+
+
+def softness(hertz: float, zeta: float, h: float) -> Softness:
+    """Box2D's ``b2MakeSoft``: the spring of frequency ``hertz`` and damping ratio ``zeta`` over h."""
+    if hertz == 0.0:
+        return Softness(0.0, 1.0, 0.0)
+    omega = 2.0 * math.pi * hertz
+    a1 = 2.0 * zeta + h * omega
+    a2 = h * omega * a1
+    a3 = 1.0 / (1.0 + a2)
+    return Softness(omega / a1, a2 * a3, a3)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -68,9 +89,14 @@ def cross_component(a: np.ndarray, b: np.ndarray, i: int, out: np.ndarray | None
     return np.subtract(a[j] * b[k], a[k] * b[j], out=out)
 
 
-def inverse_effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv_inertia_a: np.ndarray,
-                             inv_inertia_b: np.ndarray, arm_a: np.ndarray,
-                             arm_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+def inverse_effective_masses(
+    inv_mass_a: np.ndarray,
+    inv_mass_b: np.ndarray,
+    inv_inertia_a: np.ndarray,
+    inv_inertia_b: np.ndarray,
+    arm_a: np.ndarray,
+    arm_b: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """1/m_n, 1/m_t and 1/m_r of contacts whose balls have these inverse masses and inertias (each
     already multiplied by the ball's number of contacts where the mass is split, jacobi.py) and
     lever-arm lengths: how much a unit impulse changes the normal speed, the slip and the spin."""
@@ -80,19 +106,32 @@ def inverse_effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv
     return inv_n, inv_t, inv_r
 
 
-def effective_masses(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray, inv_inertia_a: np.ndarray,
-                     inv_inertia_b: np.ndarray, arm_a: np.ndarray,
-                     arm_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+def effective_masses(
+    inv_mass_a: np.ndarray,
+    inv_mass_b: np.ndarray,
+    inv_inertia_a: np.ndarray,
+    inv_inertia_b: np.ndarray,
+    arm_a: np.ndarray,
+    arm_b: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The normal, tangential (friction) and angular (rolling resistance) effective masses m_n, m_t
     and m_r (see ``inverse_effective_masses``)."""
-    inv_n, inv_t, inv_r = inverse_effective_masses(inv_mass_a, inv_mass_b, inv_inertia_a, inv_inertia_b,
-                                                   arm_a, arm_b)  # fmt: skip
+    inv_n, inv_t, inv_r = inverse_effective_masses(
+        inv_mass_a, inv_mass_b, inv_inertia_a, inv_inertia_b, arm_a, arm_b
+    )
     return 1.0 / inv_n, 1.0 / inv_t, 1.0 / inv_r
 
 
-def contact_velocity(v_a: np.ndarray, w_a: np.ndarray, v_b: np.ndarray, w_b: np.ndarray, n: np.ndarray,
-                     arm_a: np.ndarray, arm_b: np.ndarray,
-                     surface: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+def contact_velocity(
+    v_a: np.ndarray,
+    w_a: np.ndarray,
+    v_b: np.ndarray,
+    w_b: np.ndarray,
+    n: np.ndarray,
+    arm_a: np.ndarray,
+    arm_b: np.ndarray,
+    surface: np.ndarray | None = None,
+) -> np.ndarray:
     """The contact point's velocity of a relative to b, v_a − v_b + n × (ρ_a·ω_a + ρ_b·ω_b), less the
     ``surface`` velocity of a moving plane (all (3, K); ρ the lever-arm lengths, (K,))."""
     return point_velocity(v_a - v_b, spin_lever(w_a, w_b, arm_a, arm_b), n, surface)
@@ -105,8 +144,9 @@ def spin_lever(w_a: np.ndarray, w_b: np.ndarray, arm_a: np.ndarray, arm_b: np.nd
     return lever
 
 
-def point_velocity(dv: np.ndarray, lever: np.ndarray, n: np.ndarray,
-                   surface: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+def point_velocity(
+    dv: np.ndarray, lever: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None
+) -> np.ndarray:
     """``contact_velocity`` from the relative velocity ``dv`` = v_a − v_b (changed in place and
     returned) and the ``spin_lever``: dv + n × lever − surface."""
     dv += cross(n, lever)
@@ -126,8 +166,13 @@ def normal_speed(
     return v_n
 
 
-def normal_impulse(accumulated: np.ndarray, m_n: np.ndarray, target: np.ndarray, v_n: np.ndarray,
-                   give: np.ndarray | float | None = None) -> np.ndarray:  # fmt: skip
+def normal_impulse(
+    accumulated: np.ndarray,
+    m_n: np.ndarray,
+    target: np.ndarray,
+    v_n: np.ndarray,
+    give: np.ndarray | float | None = None,
+) -> np.ndarray:
     """The new accumulated normal impulse that drives v_n towards ``target``, kept ≥ 0 (a contact
     pushes, never pulls): P + m_n·(target − v_n), less ``give``·P for a soft contact (m_n then carries
     the mass scale, ``give`` is the impulse scale k)."""

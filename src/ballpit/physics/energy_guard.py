@@ -48,8 +48,9 @@ class EnergyGuards:
     frame: bool = True
 
 
-def keep_impulses(model: Model, rows: ContactRows, before: tuple[np.ndarray, ...], v: np.ndarray,
-                  w: np.ndarray) -> float:  # fmt: skip
+def keep_impulses(
+    model: Model, rows: ContactRows, before: tuple[np.ndarray, ...], v: np.ndarray, w: np.ndarray
+) -> float:
     """Make sure the impulses just applied to the balls of ``rows`` added no kinetic energy, and return
     the factor they were scaled by (1 when they added none).
 
@@ -78,8 +79,9 @@ def keep_impulses(model: Model, rows: ContactRows, before: tuple[np.ndarray, ...
     return s
 
 
-def wave_scale(model: Model, moving: bool, impulse: np.ndarray, vn: np.ndarray,
-               after: np.ndarray) -> float | None:  # fmt: skip
+def wave_scale(
+    model: Model, moving: bool, impulse: np.ndarray, vn: np.ndarray, after: np.ndarray
+) -> float | None:
     """The factor a wave's normal ``impulse`` must be scaled by so that it adds no kinetic energy, or
     None when it adds none: the change is ΔK = Σ P·v_n + ½·Σ P·Δv_n for normal impulses on spheres
     (they do not turn the balls), with ``vn`` and ``after`` each contact's normal speed before and after

@@ -63,9 +63,18 @@ def normal_speeds(rows: ContactRows, v: np.ndarray) -> np.ndarray:
     return contact_model.normal_speed(v_a, v_b, rows.normal.T, rows.surface.T if rows.moving else None)
 
 
-def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, restitution_threshold: float,
-             min_normal_speed: np.ndarray, events: EventLog, now: float, *,
-             jacobi_from: int = JACOBI_FROM) -> int:  # fmt: skip
+def in_waves(
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    rows: ContactRows,
+    restitution_threshold: float,
+    min_normal_speed: np.ndarray,
+    events: EventLog,
+    now: float,
+    *,
+    jacobi_from: int = JACOBI_FROM,
+) -> int:
     """Bounce the contacts of ``c`` that arrive, wave after wave (the module's rule); velocities
     change in place. Returns the number of waves.
 
@@ -88,8 +97,16 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, re
         idx = np.flatnonzero(arriving)
         wave = rows.subset(idx)
         before = _velocities(wave, v, w)
-        imp = solver.solve(wave, v, w, -wave.restitution * vn[idx], Impulses.zeros(len(idx)), iterations,
-                           jacobi_sweeps=BOUNCE_JACOBI_SWEEPS, jacobi_from=jacobi_from)  # fmt: skip
+        imp = solver.solve(
+            wave,
+            v,
+            w,
+            -wave.restitution * vn[idx],
+            Impulses.zeros(len(idx)),
+            iterations,
+            jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
+            jacobi_from=jacobi_from,
+        )
         scale = energy_guard.keep_impulses(model, wave, before, v, w)
         keys = c.keys() if keys is None else keys
         events.add(now, c.subset(idx), keys[idx], imp.normal * scale)
@@ -100,9 +117,17 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, re
     return waves
 
 
-def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactRows,
-                    min_normal_speed: np.ndarray, events: EventLog, now: float, *,
-                    jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
+def stop_approaches(
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    rows: ContactRows,
+    min_normal_speed: np.ndarray,
+    events: EventLog,
+    now: float,
+    *,
+    jacobi_from: int = JACOBI_FROM,
+) -> None:
     """Stop every contact still closing faster than its ``min_normal_speed`` allows (e = 0), solved over
     the island of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
 
@@ -119,9 +144,16 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     near = _island(model, c, seeds)
     island = rows.subset(near)
     before = _velocities(island, v, w)
-    imp = solver.solve(island, v, w, min_normal_speed[near], Impulses.zeros(len(island)),
-                       model.solver_iterations, jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
-                       jacobi_from=jacobi_from)  # fmt: skip
+    imp = solver.solve(
+        island,
+        v,
+        w,
+        min_normal_speed[near],
+        Impulses.zeros(len(island)),
+        model.solver_iterations,
+        jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
+        jacobi_from=jacobi_from,
+    )
     scale = energy_guard.keep_impulses(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]
@@ -149,8 +181,15 @@ def _velocities(rows: ContactRows, v: np.ndarray, w: np.ndarray) -> tuple[np.nda
     return balls, v[balls], w[balls]
 
 
-def waves_from(model: Model, rows: ContactRows, k: jacobi.Contacts, v: np.ndarray, vn_start: np.ndarray,
-               restitution_threshold: float, pressed: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
+def waves_from(
+    model: Model,
+    rows: ContactRows,
+    k: jacobi.Contacts,
+    v: np.ndarray,
+    vn_start: np.ndarray,
+    restitution_threshold: float,
+    pressed: np.ndarray,
+) -> tuple[np.ndarray, ...]:
     """The module's rule for a frame solved as a whole (the soft step's restitution, softstep.py): the
     waves are run on the normal speeds the contacts had at the frame's start, ``vn_start``, over the
     contacts that pushed during it (``pressed``), and give what each contact's normal speed should be
@@ -206,8 +245,15 @@ def waves_from(model: Model, rows: ContactRows, k: jacobi.Contacts, v: np.ndarra
     return after, struck
 
 
-def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray, target: np.ndarray,
-                 start: np.ndarray | None = None, sweeps: int = WAVE_SWEEPS) -> tuple:  # fmt: skip
+def _wave_sweeps(
+    wave: tuple,
+    m: int,
+    inv3: np.ndarray,
+    v: np.ndarray,
+    target: np.ndarray,
+    start: np.ndarray | None = None,
+    sweeps: int = WAVE_SWEEPS,
+) -> tuple:
     """One wave of ``waves_from``: normal impulses alone on its contacts (``wave``: their columns a and
     b, normals, moving surfaces, inverse masses), each ball's mass split among the wave's contacts that
     touch it (jacobi.py), driving v_n to ≥ ``target`` from the accumulated ``start`` (zero: None), at
@@ -241,8 +287,14 @@ def _wave_sweeps(wave: tuple, m: int, inv3: np.ndarray, v: np.ndarray, target: n
     return impulse, contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
 
 
-def normal_solve(rows: ContactRows, k: jacobi.Contacts, vw: np.ndarray, idx: np.ndarray, start: np.ndarray,
-                 target: np.ndarray) -> np.ndarray:  # fmt: skip
+def normal_solve(
+    rows: ContactRows,
+    k: jacobi.Contacts,
+    vw: np.ndarray,
+    idx: np.ndarray,
+    start: np.ndarray,
+    target: np.ndarray,
+) -> np.ndarray:
     """Normal impulses alone (friction and rolling resistance left out) driving the contacts ``idx`` of
     a soft frame (``rows``, ``k``) to v_n ≥ ``target``, from the accumulated ``start`` (which may be
     taken back, never below zero). Fewer than JACOBI_FROM contacts are solved colour by colour

@@ -28,51 +28,9 @@ import numpy as np
 
 from . import contact_model as model
 from .contact_model import Impulses
+from .ends import Ends
 from .rows import ContactRows
-from .settings import ADD_UP_BINS_UP_TO, CONVERGED, SORT_ENDS_FROM
-
-
-class Ends:
-    """Both ends of K contacts as columns of a compact array of the M balls they touch: ``ends`` holds
-    each contact's a then b, ``share`` each ball's number of contacts (its mass is split that many
-    ways), and ``add_up`` adds per-end values back per ball with one ``np.bincount``."""
-
-    def __init__(self, a: np.ndarray, b: np.ndarray) -> None:
-        self.k = len(a)
-        ab = np.concatenate((a, b))
-        rows_in_world = int(ab.max(initial=-1)) + 1
-        if len(ab) * SORT_ENDS_FROM < rows_in_world:  # few contacts in a big world: sorting them is cheaper
-            self.balls, self.ends = np.unique(ab, return_inverse=True)
-        else:  # the same compact numbering (balls in increasing order) from a table over the world
-            present = np.zeros(rows_in_world, bool)
-            present[ab] = True
-            self.balls = np.flatnonzero(present)
-            self.ends = np.take(np.cumsum(present) - 1, ab)
-        self.m = len(self.balls)
-        self.share = np.bincount(self.ends, minlength=self.m).astype(float)
-        self._flat: dict[int, np.ndarray] = {}  # add_up's bins for every entry, by number of rows
-
-    def add_up(self, values: np.ndarray) -> np.ndarray:
-        """(rows, 2K) values per contact end, summed per ball: (rows, M), with one ``np.bincount`` over
-        all rows (row r's entries land in bins r·M + ball). bincount adds each bin's entries in their
-        order, so every sum is the same as one row at a time, at less than one call's cost a row.
-        Beyond ADD_UP_BINS_UP_TO entries it is one call a row (the same sums), without keeping bins."""
-        rows = len(values)
-        if rows * len(self.ends) > ADD_UP_BINS_UP_TO:
-            summed = np.empty((rows, self.m))
-            for r in range(rows):
-                summed[r] = self.add_row(values[r])
-            return summed
-        flat = self._flat.get(rows)
-        if flat is None:
-            flat = (self.ends[None, :] + self.m * np.arange(rows)[:, None]).ravel()
-            self._flat[rows] = flat
-        summed = np.bincount(flat, weights=values.ravel(), minlength=rows * self.m)
-        return summed.reshape(rows, self.m)
-
-    def add_row(self, values: np.ndarray) -> np.ndarray:
-        """One row of (2K,) values per contact end, summed per ball: (M,)."""
-        return np.bincount(self.ends, weights=values, minlength=self.m)
+from .settings import ADD_UP_BINS_UP_TO, CONVERGED
 
 
 class Contacts(Ends):
@@ -104,8 +62,9 @@ class Contacts(Ends):
         self.inverse = np.stack((inv_mass, inv_inertia))  # (2, M): m⁻¹ for v's rows, I⁻¹ for ω's
         # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
         # velocity, for the convergence test
-        inv_n, inv_t, _ = model.inverse_effective_masses(self.ima, self.imb, self.iia, self.iib, self.ra,
-                                                         self.rb)  # fmt: skip
+        inv_n, inv_t, _ = model.inverse_effective_masses(
+            self.ima, self.imb, self.iia, self.iib, self.ra, self.rb
+        )
         self.whole = inv_n
         self.inv_m_n, self.inv_m_t = float(inv_n.max()), float(inv_t.max())
         self.moving = contacts.moving
@@ -129,14 +88,22 @@ class Contacts(Ends):
             counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
             share = np.maximum(counts, 1.0)
         sa, sb = share[self.ends[:k]], share[self.ends[k:]]
-        m_n, m_t, m_r = model.effective_masses(sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib,
-                                               self.ra, self.rb)  # fmt: skip
+        m_n, m_t, m_r = model.effective_masses(
+            sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
+        )
         self.m_n = m_n
         self.m_tr = np.stack((m_t, m_r))[:, None, :]
 
 
-def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarray, imp: Impulses,
-          iterations: int, friction_every: int = 1) -> Impulses:  # fmt: skip
+def solve(
+    contacts: ContactRows,
+    v: np.ndarray,
+    w: np.ndarray,
+    target: np.ndarray,
+    imp: Impulses,
+    iterations: int,
+    friction_every: int = 1,
+) -> Impulses:
     """Drive every contact's normal speed to ≥ ``target`` with friction and rolling resistance, all
     contacts at once per sweep; ``v`` and ``w`` (N+1, 3) change in place, ``imp`` accumulates.
 
@@ -151,8 +118,9 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     vw = np.ascontiguousarray(np.hstack((v[c.balls], w[c.balls])).T)  # (6, M)
     # accumulated friction (row 0) and rolling-resistance (row 1) impulses
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-    normal, tangential = sweeps(c, vw, imp.normal.copy(), tangential, target, iterations,
-                                friction_every=friction_every, converge=True)  # fmt: skip
+    normal, tangential = sweeps(
+        c, vw, imp.normal.copy(), tangential, target, iterations, friction_every=friction_every, converge=True
+    )
     v[c.balls] = vw[:3].T
     w[c.balls] = vw[3:].T
     v[-1] = 0.0
@@ -161,10 +129,19 @@ def solve(contacts: ContactRows, v: np.ndarray, w: np.ndarray, target: np.ndarra
     return imp
 
 
-def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarray | None,
-           target: np.ndarray, count: int, *, friction_every: int | None = None,
-           m_n: np.ndarray | None = None, give: np.ndarray | float | None = None,
-           converge: bool = False) -> tuple[np.ndarray, np.ndarray | None]:  # fmt: skip
+def sweeps(
+    c: Contacts,
+    vw: np.ndarray,
+    normal: np.ndarray,
+    tangential: np.ndarray | None,
+    target: np.ndarray,
+    count: int,
+    *,
+    friction_every: int | None = None,
+    m_n: np.ndarray | None = None,
+    give: np.ndarray | float | None = None,
+    converge: bool = False,
+) -> tuple[np.ndarray, np.ndarray | None]:
     """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
     and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
     accumulated normal and tangential ((2, 3, K): friction, rolling) impulses. The ``tangential`` given
@@ -180,8 +157,9 @@ def sweeps(c: Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarr
         if not full:
             normal = _normal_sweep(c, vw, c.push, normal, target, m_n, give)
             continue
-        normal, tangential, change = _full_sweep(c, vw, c.push, normal, tangential, target, c.motion, m_n,
-                                                 give, converge)  # fmt: skip
+        normal, tangential, change = _full_sweep(
+            c, vw, c.push, normal, tangential, target, c.motion, m_n, give, converge
+        )
         if converge and change < CONVERGED:
             break
     return normal, tangential
@@ -219,8 +197,9 @@ def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tan
     vw += total
 
 
-def _apply_by_rows(c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray,
-                   d_r: np.ndarray) -> None:  # fmt: skip
+def _apply_by_rows(
+    c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray, d_r: np.ndarray
+) -> None:
     """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
     ball, are those of the (6, 2K) block."""
     k, n = c.k, c.n
@@ -243,8 +222,15 @@ def _apply_by_rows(c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndar
     vw += total
 
 
-def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, target: np.ndarray,
-                  m_n: np.ndarray, give: np.ndarray | float | None) -> np.ndarray:  # fmt: skip
+def _normal_sweep(
+    c: Contacts,
+    vw: np.ndarray,
+    push: np.ndarray,
+    normal: np.ndarray,
+    target: np.ndarray,
+    m_n: np.ndarray,
+    give: np.ndarray | float | None,
+) -> np.ndarray:
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
     vn = normal_speeds(c, vw, n, c.surface)
@@ -267,9 +253,18 @@ def _normal_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndar
     return new
 
 
-def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
-                target: np.ndarray, motion: np.ndarray, m_n: np.ndarray, give: np.ndarray | float | None,
-                measure: bool) -> tuple[np.ndarray, np.ndarray, float]:  # fmt: skip
+def _full_sweep(
+    c: Contacts,
+    vw: np.ndarray,
+    push: np.ndarray,
+    normal: np.ndarray,
+    tangential: np.ndarray,
+    target: np.ndarray,
+    motion: np.ndarray,
+    m_n: np.ndarray,
+    give: np.ndarray | float | None,
+    measure: bool,
+) -> tuple[np.ndarray, np.ndarray, float]:
     """One sweep of normal, friction and rolling impulses, all from the velocities at its start;
     ``vw`` changes in place. Returns the impulses and (when ``measure``) a bound on the largest
     velocity change it made at any contact (m/s)."""
@@ -311,40 +306,3 @@ def _full_sweep(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarra
     if measure:
         change = max(float(np.abs(d_n).max()) * c.inv_m_n, float(np.abs(d_tr[0]).max()) * c.inv_m_t)
     return new, new_tr, change
-
-
-def separate(a: np.ndarray, b: np.ndarray, normal: np.ndarray, gap: np.ndarray, inv_mass_a: np.ndarray,
-             inv_mass_b: np.ndarray, pos: np.ndarray, sweeps: int) -> None:  # fmt: skip
-    """Move overlapping balls apart along their normals, all contacts at once per sweep: each
-    contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
-    proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world.
-
-    Every sweep works one coordinate at a time, on (K,) and (2K,) rows: the same operations in the same
-    order as on (3, K) blocks (v_n as ``contact_model.dot`` sums it, each row added up as ``add_up``
-    does), without their memory."""
-    e = Ends(a, b)
-    k, balls, ends, share = e.k, e.balls, e.ends, e.share
-    ea, eb = ends[:k], ends[k:]
-    fa, fb = model.separation_parts(share[ea] * inv_mass_a, share[eb] * inv_mass_b)  # each end's part
-    n = np.ascontiguousarray(normal.T)
-    x = np.ascontiguousarray(pos[balls].T)  # (3, M)
-
-    def along() -> np.ndarray:  # n·(x_a − x_b) per contact
-        d = n[0] * (np.take(x[0], ea) - np.take(x[0], eb))
-        d += n[1] * (np.take(x[1], ea) - np.take(x[1], eb))
-        d += n[2] * (np.take(x[2], ea) - np.take(x[2], eb))
-        return d
-
-    start = along()
-    move = np.empty(2 * k)  # one coordinate's moves of every contact's a (:K) then b (K:)
-    for _ in range(sweeps):
-        now = gap + along() - start
-        deficit = np.maximum(-now, 0.0)
-        for r in range(3):
-            d = deficit * n[r]
-            np.multiply(d, fa, out=move[:k])
-            np.multiply(d, fb, out=move[k:])
-            # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
-            x[r] += e.add_row(move) / share
-    pos[balls] = x.T
-    pos[-1] = 0.0

@@ -81,8 +81,9 @@ class Model:
         self.substeps = 1  # soft substeps of a crowded step (softstep.py)
         self.guards = EnergyGuards()  # which energy guards are on (energy_guard.py): all, but in tests
 
-    def append_spheres(self, n: int, *, radius, mass, restitution, friction, rolling_friction,
-                       hollow) -> slice:  # fmt: skip
+    def append_spheres(
+        self, n: int, *, radius, mass, restitution, friction, rolling_friction, hollow
+    ) -> slice:
         """Room for ``n`` more balls with these (validated, broadcastable) properties; their rows."""
         cols = self.spheres
         rows = cols.reserve(n)

@@ -127,8 +127,9 @@ def _length(x: list[float]) -> float:
     return math.sqrt((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
 
 
-def closing_speed_bound(model: Model, state: State, ball: np.ndarray, plane: np.ndarray, v: np.ndarray,
-                        acc: np.ndarray, h: float) -> np.ndarray:  # fmt: skip
+def closing_speed_bound(
+    model: Model, state: State, ball: np.ndarray, plane: np.ndarray, v: np.ndarray, acc: np.ndarray, h: float
+) -> np.ndarray:
     """A bound on how fast each ball (velocity ``v``, acceleration ``acc`` along its path) can close on
     its moving plane over the next ``h``: |v − v_p| + |a|·h + |ω_p|·D, where D bounds the ball's
     distance from the plane's centre over the interval (the closest point is never farther)."""

@@ -22,8 +22,18 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
     x, radius = state.body[:, X], model.spheres.radius
     c = pairs
     pose = state.planes
-    gp, np_, pp = collision.sphere_plane(x, radius, c.sphere, c.plane, c.side, pose.center, pose.normal,
-                                         pose.axis_u, pose.axis_v, model.planes.half_size)  # fmt: skip
+    gp, np_, pp = collision.sphere_plane(
+        x,
+        radius,
+        c.sphere,
+        c.plane,
+        c.side,
+        pose.center,
+        pose.normal,
+        pose.axis_u,
+        pose.axis_v,
+        model.planes.half_size,
+    )
     gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
     static = np.full(len(c.sphere), model.spheres.count)
     kind = np.full(len(gp) + len(gs), SPHERE_SPHERE, np.int8)  # one byte a pair

@@ -159,8 +159,9 @@ class PairCache:
         """Put back the kept pairs of ``saved`` (a ``checkpoint``; it stays usable)."""
         self.kept = None if saved.kept is None else shallow_copy(saved.kept)
 
-    def for_step(self, model: Model, state: State, accel: np.ndarray, dt: float,
-                 awake: np.ndarray | None) -> KeptPairs:  # fmt: skip
+    def for_step(
+        self, model: Model, state: State, accel: np.ndarray, dt: float, awake: np.ndarray | None
+    ) -> KeptPairs:
         """The pairs for a step whose free acceleration is ``accel``: kept ones if they still hold."""
         c = self.kept
         counts = (model.spheres.count, model.planes.count)
@@ -171,8 +172,16 @@ class PairCache:
         c.side = plane_sides(model, state, c.sphere, c.plane)
         return c.among(awake)
 
-    def renew(self, model: Model, state: State, h: float, ahead: float, accel: np.ndarray,
-              free: np.ndarray, awake: np.ndarray | None) -> KeptPairs:  # fmt: skip
+    def renew(
+        self,
+        model: Model,
+        state: State,
+        h: float,
+        ahead: float,
+        accel: np.ndarray,
+        free: np.ndarray,
+        awake: np.ndarray | None,
+    ) -> KeptPairs:
         """Find pairs afresh and keep them (they cover ``ahead`` seconds, so later steps reuse them)."""
         self.kept = find_pairs(model, state, h, ahead, accel, free)
         return self.kept.among(awake)
@@ -206,8 +215,9 @@ def plane_sides(model: Model, state: State, sphere: np.ndarray, plane: np.ndarra
     return np.where(signed < 0.0, -1.0, 1.0)
 
 
-def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.ndarray,
-               free: np.ndarray) -> KeptPairs:  # fmt: skip
+def find_pairs(
+    model: Model, state: State, h: float, ahead: float, accel: np.ndarray, free: np.ndarray
+) -> KeptPairs:
     """Candidate pairs from boxes around each ball's swept path.
 
     Each box covers the next ``h`` seconds under ``accel`` (contact forces included), and beyond it
@@ -254,12 +264,14 @@ def find_pairs(model: Model, state: State, h: float, ahead: float, accel: np.nda
     counts = (model.spheres.count, model.planes.count)
     sides = plane_sides(model, state, s, p)
     still = ~model.moving_plane_mask()
-    return KeptPairs(lo.T, hi.T, centre.T, reach, i, j, s, p, sides, counts, still=still,
-                     _columns=(lo, hi, centre))  # fmt: skip
+    return KeptPairs(
+        lo.T, hi.T, centre.T, reach, i, j, s, p, sides, counts, still=still, _columns=(lo, hi, centre)
+    )
 
 
-def plane_pairs(model: Model, state: State, lo: np.ndarray, hi: np.ndarray, h: float,
-                planes: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def plane_pairs(
+    model: Model, state: State, lo: np.ndarray, hi: np.ndarray, h: float, planes: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """(sphere, plane) pairs whose boxes reach the plane, as it is or as it moves over ``h``, for the
     ``planes`` given (all when None)."""
     pose, pl = state.planes, model.planes

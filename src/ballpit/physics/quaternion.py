@@ -89,3 +89,11 @@ def derivative(q: np.ndarray, omega: np.ndarray, out: np.ndarray) -> np.ndarray:
     out[:, 3] = -(wx * qx + wy * qy + wz * qz)
     out *= 0.5
     return out
+
+
+def turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
+    """q ← normalise(q + h·½·(ω, 0)⊗q), in place (``w`` is (3, M))."""
+    dq = np.empty_like(q)
+    derivative(q, w.T, dq)
+    q += h * dq
+    normalize(q, out=q)

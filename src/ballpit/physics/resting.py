@@ -146,10 +146,21 @@ def _parts(imp: Impulses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return imp.normal, imp.friction, imp.rolling
 
 
-def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray,
-                   ang: np.ndarray, h: float, dt: float, min_normal_speed: np.ndarray, warm: WarmStart,
-                   events: EventLog, now: float, jacobi_from: int = JACOBI_FROM
-                   ) -> ConstantPerBall | None:  # fmt: skip
+def resting_forces(
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    rows: ContactRows,
+    lin: np.ndarray,
+    ang: np.ndarray,
+    h: float,
+    dt: float,
+    min_normal_speed: np.ndarray,
+    warm: WarmStart,
+    events: EventLog,
+    now: float,
+    jacobi_from: int = JACOBI_FROM,
+) -> ConstantPerBall | None:
     """Constant contact forces over the next ``h`` seconds that leave each contact's normal speed at
     least ``min_normal_speed`` (0 for a touching contact, −gap/dt for a speculative one) at the
     interval's end.
@@ -172,16 +183,25 @@ def resting_forces(model: Model, state: State, c: ContactPoints, rows: ContactRo
         rows = rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
-    hold_by_planes(rows, c.gap, model.spheres.radius, with_static(state.body[:, V]), v, min_normal_speed,
-                   imp.normal, h)  # fmt: skip
+    hold_by_planes(
+        rows, c.gap, model.spheres.radius, with_static(state.body[:, V]), v, min_normal_speed, imp.normal, h
+    )
     if h >= WARM_START_SPAN * dt:
         warm.keep(keys, imp, h)
     events.add_resting(now, c, keys, imp.normal)
     return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)
 
 
-def hold_by_planes(rows: ContactRows, gap: np.ndarray, radius: np.ndarray, v_start: np.ndarray, v: np.ndarray,
-                   target: np.ndarray, normal: np.ndarray, h: float) -> None:  # fmt: skip
+def hold_by_planes(
+    rows: ContactRows,
+    gap: np.ndarray,
+    radius: np.ndarray,
+    v_start: np.ndarray,
+    v: np.ndarray,
+    target: np.ndarray,
+    normal: np.ndarray,
+    h: float,
+) -> None:
     """Planes win: no ball the solve left sinking into a plane it touches by more than HOLD_SINK of its
     radius over the interval is let sink at all. ``v_start`` and ``v`` (N+1, 3) are the velocities at
     the interval's start and end (the end changes in place), ``normal`` the accumulated normal impulses
@@ -219,20 +239,7 @@ def hold_by_planes(rows: ContactRows, gap: np.ndarray, radius: np.ndarray, v_sta
     held[rows.a[deeper]] = True
     planes = np.flatnonzero(static & held[rows.a])
     _push_off_planes(rows, v, target, normal, planes)
-    # the normals of the planes pushing each held ball, made orthonormal (at most three)
-    slot = np.full(balls, -1)
-    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
-    basis = np.zeros((np.count_nonzero(held), 3, 3))
-    count = np.zeros(len(basis), np.intp)
-    pushing = planes[normal[planes] > 0.0]
-    for group in rows.subset(pushing).colours:  # one contact per ball in each colour
-        k = slot[rows.a[pushing[group]]]
-        u = _off(basis[k], n[pushing[group]])
-        length = exact.norm(u)
-        ok = (length > 1e-6) & (count[k] < 3)
-        k = k[ok]
-        basis[k, count[k]] = u[ok] / length[ok, None]
-        count[k] += 1
+    slot, basis = _plane_bases(rows, held, planes[normal[planes] > 0.0])
     pressed = np.flatnonzero(~static & (held[rows.a] | held[rows.b]))
     moved = held.copy()
     if pressed.size:
@@ -258,6 +265,24 @@ def hold_by_planes(rows: ContactRows, gap: np.ndarray, radius: np.ndarray, v_sta
         _push_off_planes(rows, v, target, normal, last)
 
 
+def _plane_bases(rows: ContactRows, held: np.ndarray, pushing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The normals of the plane contacts ``pushing`` each ``held`` ball, made orthonormal (Gram–Schmidt,
+    at most three): each held ball's row ``slot`` into ``basis`` (its (3, 3) rows; zero rows unused)."""
+    slot = np.full(len(held), -1)
+    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
+    basis = np.zeros((np.count_nonzero(held), 3, 3))
+    count = np.zeros(len(basis), np.intp)
+    for group in rows.subset(pushing).colours:  # one contact per ball in each colour
+        k = slot[rows.a[pushing[group]]]
+        u = _off(basis[k], rows.normal[pushing[group]])
+        length = exact.norm(u)
+        ok = (length > 1e-6) & (count[k] < 3)
+        k = k[ok]
+        basis[k, count[k]] = u[ok] / length[ok, None]
+        count[k] += 1
+    return slot, basis
+
+
 def _normal_speeds(rows: ContactRows, v: np.ndarray, idx: np.ndarray | slice = slice(None)) -> np.ndarray:
     """v_n of the contacts ``idx`` under the (N+1, 3) velocities ``v``, against a moving surface: the
     contact model's ``normal_speed`` on these rows."""
@@ -275,8 +300,9 @@ def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
     return u
 
 
-def _push_off_planes(rows: ContactRows, v: np.ndarray, target: np.ndarray, normal: np.ndarray,
-                     idx: np.ndarray) -> None:  # fmt: skip
+def _push_off_planes(
+    rows: ContactRows, v: np.ndarray, target: np.ndarray, normal: np.ndarray, idx: np.ndarray
+) -> None:
     """Drive the contacts ``idx`` (each against a body of no inverse mass) up to their target normal
     speed by moving their ball alone, colour by colour; impulses are only added."""
     if idx.size == 0:

@@ -140,8 +140,9 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
     return colours
 
 
-def rows_at_end(model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray, h: float,
-                warm: Impulses) -> ContactRows:  # fmt: skip
+def rows_at_end(
+    model: Model, state: State, c: ContactPoints, rows: ContactRows, lin: np.ndarray, h: float, warm: Impulses
+) -> ContactRows:
     """The contact rows of ``c`` as they will be ``h`` seconds on, on turning planes (``rows`` as they
     are now, ``lin`` the balls' free accelerations, ``warm`` the warm-start impulses, whose friction is
     turned onto the new tangent planes in place).

@@ -3,7 +3,7 @@
 Three named steps, in this order (softstep.frame runs them):
 
 1. ``move_apart``: contacts overlapping deeper than the slop go back to 0.8 of it, each ball moved in
-   proportion to its inverse mass (Jacobi sweeps, jacobi.separate), never through a plane, the lift
+   proportion to its inverse mass (Jacobi sweeps, penetration.separate), never through a plane, the lift
    paid out of the balls' speed (energy_guard.pay_for_lift). An overlap the frame began with is moved
    only as far as MAX_PUSH would have moved it in the frame: a heap of balls created at one point is
    pushed apart, never launched by a jump of positions.
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import energy_guard, jacobi, penetration
+from . import energy_guard, penetration
 from .model import Model
 from .resting import WarmStart
 from .settings import MAX_PUSH, SEPARATE_SWEEPS, SLOP
@@ -50,16 +50,27 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
     part = np.flatnonzero(made < -2.0 * made.min())
     pos = with_static(body[:, X])
     normals = np.take(c.normal.T, part, axis=1).T  # laid out as (3, K) columns, as separate reads them
-    jacobi.separate(c.a[part], c.b[part], normals, made[part], rows.inv_mass_a[part], rows.inv_mass_b[part],
-                    pos, SEPARATE_SWEEPS)  # fmt: skip
+    penetration.separate(
+        c.a[part],
+        c.b[part],
+        normals,
+        made[part],
+        rows.inv_mass_a[part],
+        rows.inv_mass_b[part],
+        pos,
+        SEPARATE_SWEEPS,
+    )
     del normals
     new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
     energy_guard.pay_for_lift(model, state, body[:, X], new)
     moved = new - body[:, X]
     ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
     d = ma - mb
-    np.minimum(f.least, s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
-               out=f.least)  # fmt: skip
+    np.minimum(
+        f.least,
+        s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
+        out=f.least,
+    )
     body[:, X] = new
     return s
 

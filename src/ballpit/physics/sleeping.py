@@ -115,8 +115,9 @@ def links(c: ContactPoints, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return c.a[linked], c.other[linked]
 
 
-def after_step(model: Model, state: State, sleep: Sleep, joined: tuple[np.ndarray, np.ndarray] | None,
-               dt: float) -> None:  # fmt: skip
+def after_step(
+    model: Model, state: State, sleep: Sleep, joined: tuple[np.ndarray, np.ndarray] | None, dt: float
+) -> None:
     """Update the rest timers and put to sleep the islands whose balls have all been still for
     TIME_TO_SLEEP; wake any sleeping ball the step left moving.
 

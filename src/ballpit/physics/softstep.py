@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import impacts, jacobi, quaternion, separate
-from .contact_model import Impulses, dot
+from .contact_model import Impulses, dot, softness
 from .contacts import ContactPoints
 from .forces import ForceTerm, constant_acceleration, forces_of
 from .model import Model
@@ -55,26 +55,6 @@ from .resting import WarmStart
 from .rows import contact_rows
 from .settings import CONTACT_HERTZ, DAMPING_RATIO, LEVEL, MAX_PUSH, RELAX_SWEEPS, SOLVE_SWEEPS
 from .state import Q, State, V, W, X
-
-
-@dataclass(frozen=True)
-class Softness:
-    """A soft constraint's coefficients for a substep h (see the module docstring)."""
-
-    bias_rate: float
-    mass_scale: float
-    impulse_scale: float
-
-
-def softness(hertz: float, zeta: float, h: float) -> Softness:
-    """Box2D's ``b2MakeSoft``: the spring of frequency ``hertz`` and damping ratio ``zeta`` over h."""
-    if hertz == 0.0:
-        return Softness(0.0, 1.0, 0.0)
-    omega = 2.0 * math.pi * hertz
-    a1 = 2.0 * zeta + h * omega
-    a2 = h * omega * a1
-    a3 = 1.0 / (1.0 + a2)
-    return Softness(omega / a1, a2 * a3, a3)
 
 
 @dataclass
@@ -93,8 +73,17 @@ class Frame:
     hi: np.ndarray
 
 
-def frame(model: Model, state: State, c: ContactPoints, forces: list[ForceTerm], dt: float, threshold: float,
-          warm: WarmStart, substeps: int, profile: StepProfile) -> Frame:  # fmt: skip
+def frame(
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    forces: list[ForceTerm],
+    dt: float,
+    threshold: float,
+    warm: WarmStart,
+    substeps: int,
+    profile: StepProfile,
+) -> Frame:
     """Advance the balls the contacts ``c`` touch by ``dt`` in ``substeps`` substeps (their states
     change in place; planes and other balls do not move here). ``warm`` gives and keeps the impulses;
     ``threshold`` is the restitution threshold (m/s). Each stage is timed into ``profile``."""
@@ -133,8 +122,16 @@ class SoftFrame:
     impulses), so that moving overlaps apart does not hold them too (the peak memory of a settled
     pile)."""
 
-    def __init__(self, model: Model, state: State, c: ContactPoints, forces: list[ForceTerm], dt: float,
-                 warm: WarmStart, substeps: int) -> None:  # fmt: skip
+    def __init__(
+        self,
+        model: Model,
+        state: State,
+        c: ContactPoints,
+        forces: list[ForceTerm],
+        dt: float,
+        warm: WarmStart,
+        substeps: int,
+    ) -> None:
         self.c, self.dt = c, dt
         self.h = h = dt / substeps
         n_balls = model.spheres.count
@@ -227,7 +224,7 @@ def integrate_positions(f: SoftFrame) -> None:
     live = f.live
     before = f.x[:, live].copy()
     f.x[:, live] += f.vw[:3, live] * f.h
-    _turn(f.q, f.vw[3:, live], f.h)
+    quaternion.turn(f.q, f.vw[3:, live], f.h)
     moved = f.x[:, live] - before
     np.maximum(f.largest[live], _length(moved), out=f.largest[live])
     del before, moved
@@ -320,22 +317,30 @@ def _length(a: np.ndarray) -> np.ndarray:
     return np.sqrt(dot(a, a))
 
 
-def _soft_sweeps(k: jacobi.Contacts, vw: np.ndarray, normal: np.ndarray, tangential: np.ndarray,
-                 target: np.ndarray, scale: np.ndarray | float, give: np.ndarray | float,
-                 sweeps: int) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def _soft_sweeps(
+    k: jacobi.Contacts,
+    vw: np.ndarray,
+    normal: np.ndarray,
+    tangential: np.ndarray,
+    target: np.ndarray,
+    scale: np.ndarray | float,
+    give: np.ndarray | float,
+    sweeps: int,
+) -> tuple[np.ndarray, np.ndarray]:
     """``sweeps`` Jacobi sweeps of the soft normal update ΔP = m_n·scale·(target − v_n) − give·P (P ≥ 0);
     the last one also updates friction (the Coulomb cone |P_t| ≤ μ·P_n) and rolling resistance
     (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses.
 
     The spring's give, −give·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
     give·P/m_whole), so a ball's share of a crowd does not make its contacts softer."""
-    return jacobi.sweeps(k, vw, normal, tangential, target, sweeps, friction_every=sweeps,
-                         m_n=k.m_n * scale, give=give * k.m_n * k.whole)  # fmt: skip
-
-
-def _turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
-    """q ← normalise(q + h·½·(ω, 0)⊗q), in place (``w`` is (3, M))."""
-    dq = np.empty_like(q)
-    quaternion.derivative(q, w.T, dq)
-    q += h * dq
-    quaternion.normalize(q, out=q)
+    return jacobi.sweeps(
+        k,
+        vw,
+        normal,
+        tangential,
+        target,
+        sweeps,
+        friction_every=sweeps,
+        m_n=k.m_n * scale,
+        give=give * k.m_n * k.whole,
+    )

@@ -17,6 +17,7 @@ import numpy as np
 from . import contact_model as model
 from . import jacobi
 from .contact_model import Impulses
+from .ends import Ends
 from .rows import ContactRows
 from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 
@@ -94,7 +95,7 @@ def solve(
         return jacobi.solve(contacts, v, w, target, imp, jacobi_sweeps * iterations, friction_every)
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
-    ends = jacobi.Ends(contacts.a, contacts.b)
+    ends = Ends(contacts.a, contacts.b)
     vw = np.ascontiguousarray(np.hstack((v[ends.balls], w[ends.balls])).T)  # (6, M)
     colours = [_Colour(contacts, idx, ends.ends) for idx in contacts.colours]
     targets = [target[c.idx] for c in colours]
@@ -118,8 +119,9 @@ def solve(
     return imp
 
 
-def _sweep_colour(c: _Colour, vw: np.ndarray, target: np.ndarray, normal: list, friction: list, rolling: list,
-                  k: int) -> float:  # fmt: skip
+def _sweep_colour(
+    c: _Colour, vw: np.ndarray, target: np.ndarray, normal: list, friction: list, rolling: list, k: int
+) -> float:
     """One colour's update, in Gauss–Seidel order within each contact: normal impulse, then friction,
     then rolling resistance (from the spin friction left). Returns a bound on the largest velocity
     change it made (m/s)."""

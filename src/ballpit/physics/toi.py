@@ -86,8 +86,9 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
 
 
-def deep_overlaps(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float,
-                  depth: float) -> np.ndarray:  # fmt: skip
+def deep_overlaps(
+    model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float, depth: float
+) -> np.ndarray:
     """The pairs of ``c`` (not yet touching) that would overlap by more than ``depth`` times the
     smaller radius within ``h``, as a mask over ``c``."""
     deep = lambda ra, rb: -depth * np.where(rb > 0.0, np.minimum(ra, rb), ra)  # noqa: E731
@@ -97,8 +98,9 @@ def deep_overlaps(model: Model, state: State, c: ContactPoints, accel: np.ndarra
     return mask
 
 
-def meetings(model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float,
-             target) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+def meetings(
+    model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float, target
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
     ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
     all (their indices into ``c``)."""
@@ -155,8 +157,17 @@ def _dot(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return p[:, 0] * q[:, 0] + p[:, 1] * q[:, 1] + p[:, 2] * q[:, 2]
 
 
-def earliest(model: Model, state: State, c: ContactPoints, apart: np.ndarray, x: np.ndarray,
-             v: np.ndarray, acc: np.ndarray, h: float, goal: np.ndarray) -> np.ndarray:  # fmt: skip
+def earliest(
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    apart: np.ndarray,
+    x: np.ndarray,
+    v: np.ndarray,
+    acc: np.ndarray,
+    h: float,
+    goal: np.ndarray,
+) -> np.ndarray:
     """A time before which no pair ``apart`` of ``c`` can have its gap down to ``goal`` (inf: not
     within ``h``), so conservative advancement need not crawl up to it.
 

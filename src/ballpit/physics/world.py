@@ -12,7 +12,7 @@ import copy
 
 import numpy as np
 
-from . import edits, energy, moving_planes, validation
+from . import edits, energy, moving_planes, steppable, validation
 from . import step as pipeline
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .checkpoint import Checkpoint, Parts
@@ -143,8 +143,18 @@ class World:
         hollow: bool = False,
     ) -> Sphere:
         """Add one ball and return its live view."""
-        row = validation.ball(position, radius, mass, velocity, angular_velocity, orientation, restitution,
-                              friction, rolling_friction, hollow)  # fmt: skip
+        row = validation.ball(
+            position,
+            radius,
+            mass,
+            velocity,
+            angular_velocity,
+            orientation,
+            restitution,
+            friction,
+            rolling_friction,
+            hollow,
+        )
         return Sphere(self, self._append_spheres(1, **row))
 
     def add_spheres(
@@ -164,14 +174,25 @@ class World:
 
         Returns the new balls' indices.
         """
-        rows = validation.balls(positions, radius, mass, velocity, angular_velocity, orientation, restitution,
-                                friction, rolling_friction, hollow)  # fmt: skip
+        rows = validation.balls(
+            positions,
+            radius,
+            mass,
+            velocity,
+            angular_velocity,
+            orientation,
+            restitution,
+            friction,
+            rolling_friction,
+            hollow,
+        )
         n = len(rows["position"])
         first = self._append_spheres(n, **rows)
         return np.arange(first, first + n)
 
-    def _append_spheres(self, n: int, *, position, velocity, angular_velocity, orientation,
-                        **properties) -> int:  # fmt: skip
+    def _append_spheres(
+        self, n: int, *, position, velocity, angular_velocity, orientation, **properties
+    ) -> int:
         rows = self.model.append_spheres(n, **properties)
         body = self.state.reserve(n)
         body[:, X] = position
@@ -247,7 +268,7 @@ class World:
 
     def _remember_planes(self) -> None:
         """Copy the plane columns, to put back a bad value written into them before the next step."""
-        self._good_planes = validation.planes_as_stepped(self.model.planes, self.state.planes)
+        self._good_planes = steppable.planes_as_stepped(self.model.planes, self.state.planes)
 
     # ------------------------------------------------------------------ stepping
     def forces(self) -> list[ForceTerm]:

@@ -23,7 +23,7 @@ from time import perf_counter
 
 import numpy as np
 
-from .. import validation
+from .. import steppable, validation
 from ..checkpoint import Checkpoint, Parts
 from ..contacts import ContactRecord, EventLog
 from ..integrators import Workspace
@@ -38,15 +38,16 @@ from .sleep import Awake, settle, wake
 __all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "settle", "solve", "wake"]
 
 
-def prepare(model: Model, parts: Parts, workspace: Workspace, dt: float,
-            good_planes: np.ndarray | None) -> Step:  # fmt: skip
+def prepare(
+    model: Model, parts: Parts, workspace: Workspace, dt: float, good_planes: np.ndarray | None
+) -> Step:
     """The step's context, once it is sure the engine can step the world: ValueError naming what it
     cannot (a bad plane value is put back to ``good_planes``, the columns as the last step left them)."""
     dt = validation.number("dt", dt, positive=True)
     began = perf_counter()
     state = parts.state
-    validation.reject_unsteppable_state(state.body)
-    planes = validation.reject_bad_planes(model.planes, state.planes, good_planes)
+    steppable.reject_unsteppable_state(state.body)
+    planes = steppable.reject_bad_planes(model.planes, state.planes, good_planes)
     threshold = model.restitution_threshold_for(dt)
     return Step(model, parts, workspace, dt, threshold, EventLog(), StepProfile(), began, planes)
 
@@ -70,7 +71,7 @@ def finish(step: Step, checkpoint: Checkpoint, chosen: Plan, pairs: int) -> Cont
     """Undo a step that made anything non-finite (or beyond what the engine can step): every part back
     to ``checkpoint``, and raise. Else advance the time, and return the contacts resolved with the
     profile filled in."""
-    fault = validation.step_fault(step.state.body)
+    fault = steppable.step_fault(step.state.body)
     if fault is not None:
         checkpoint.restore(step.parts)
         raise fault

@@ -36,7 +36,7 @@ class Step:
     events: EventLog
     profile: StepProfile
     began: float  # perf_counter() when the step began
-    checked_planes: np.ndarray  # the plane columns as the step found them (validation.reject_bad_planes)
+    checked_planes: np.ndarray  # the plane columns as the step found them (steppable.reject_bad_planes)
     intervals: int = 0
 
     # the parts, each by its name (read often)

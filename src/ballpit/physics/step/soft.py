@@ -101,8 +101,16 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     return True
 
 
-def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c: ContactPoints,
-         substeps: int, last: bool, checkpoint: Checkpoint) -> softstep.Frame | None:  # fmt: skip
+def _try(
+    step: Step,
+    motion: Motion,
+    gaps: ContactPoints,
+    solved: np.ndarray,
+    c: ContactPoints,
+    substeps: int,
+    last: bool,
+    checkpoint: Checkpoint,
+) -> softstep.Frame | None:
     """One try at the soft frame with ``substeps`` substeps: the frame, or None (everything undone to
     ``checkpoint``) when its ``verdict`` is not KEPT. The ``last`` try is kept when its only fault is a
     solved contact that overlapped DEEPER: that is no pass through anything, and splitting a heap of
@@ -133,8 +141,15 @@ def _try(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c:
     return None
 
 
-def verdict(step: Step, motion: Motion, gaps: ContactPoints, solved: np.ndarray, c: ContactPoints,
-            frame: softstep.Frame, before: np.ndarray) -> Verdict:  # fmt: skip
+def verdict(
+    step: Step,
+    motion: Motion,
+    gaps: ContactPoints,
+    solved: np.ndarray,
+    c: ContactPoints,
+    frame: softstep.Frame,
+    before: np.ndarray,
+) -> Verdict:
     """Whether a soft frame kept its promises (see ``frames``), or why it cannot be trusted.
 
     ``gaps`` are the kept pairs' gaps at the frame's start (``ContactPoints.gaps``), ``solved`` which
@@ -205,8 +220,9 @@ def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) 
         d = before[s, 0:3] - pose.center[p]
         nrm = pose.normal[p]
         side = np.where(d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2] < 0.0, -1.0, 1.0)
-        gap[on_plane] = collision.sphere_plane(x, radius, s, p, side, pose.center, pose.normal, pose.axis_u,
-                                               pose.axis_v, model.planes.half_size)[0]  # fmt: skip
+        gap[on_plane] = collision.sphere_plane(
+            x, radius, s, p, side, pose.center, pose.normal, pose.axis_u, pose.axis_v, model.planes.half_size
+        )[0]
     if (~on_plane).any():
         gap[~on_plane] = collision.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
     return gap

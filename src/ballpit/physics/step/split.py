@@ -42,14 +42,27 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
             penetration.remove_penetration(model, state, touching, batch)
         min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
         with prof.stage(Stage.IMPACTS):  # arrivals bounce in waves; then slower approaches stop
-            impacts.in_waves(model, state, touching, batch, step.restitution_threshold, min_normal_speed,
-                             step.events, now)  # fmt: skip
+            impacts.in_waves(
+                model, state, touching, batch, step.restitution_threshold, min_normal_speed, step.events, now
+            )
             impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now)
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, forces)
         with prof.stage(Stage.RESTING_SOLVE):
-            push = resting.resting_forces(model, state, touching, batch, free, ang, remaining, dt,
-                                          min_normal_speed, step.warm, step.events, now)  # fmt: skip
+            push = resting.resting_forces(
+                model,
+                state,
+                touching,
+                batch,
+                free,
+                ang,
+                remaining,
+                dt,
+                min_normal_speed,
+                step.warm,
+                step.events,
+                now,
+            )
         lin = free if push is None else free + push.lin
         # The first interval's free path was checked against the boxes when the pairs were taken; a
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again
@@ -70,8 +83,14 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         elapsed = dt if h >= remaining else elapsed + h
 
 
-def finish_conservatively(step: Step, motion: Motion, contacts: ContactPoints, push: ConstantPerBall | None,
-                          lin: np.ndarray, remaining: float) -> None:  # fmt: skip
+def finish_conservatively(
+    step: Step,
+    motion: Motion,
+    contacts: ContactPoints,
+    push: ConstantPerBall | None,
+    lin: np.ndarray,
+    remaining: float,
+) -> None:
     """Take the rest of a step that ran out of intervals in one go, passing through nothing: every
     ball that could reach anything in that time stops where it is (velocity and spin zero, its
     forces balanced), and the others, which cannot, move on."""
