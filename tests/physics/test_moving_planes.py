@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.settings import CONTACT_SLOP, OVERLAP_TOLERANCE
+from ballpit.physics.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
 
 G = 9.81
 RATES = [60, 240]
@@ -93,7 +93,7 @@ def test_square_tilted_under_a_resting_ball_never_lets_it_sink_then_it_rolls_at_
     # it at most r·(1 − cos ω·dt) closer (second order: 1.7 µm at 60 Hz); the next step takes that
     # back, down to the overlap the engine leaves alone as rounding. Sinking would be that overlap
     # growing from step to step.
-    turn_in_a_step = r * (1 - math.cos(rate * dt)) + OVERLAP_TOLERANCE
+    turn_in_a_step = r * (1 - math.cos(rate * dt)) + PENETRATION_TOLERANCE
     for _ in range(round(theta / rate / dt)):
         world.step(dt)
         assert square.signed_distance(ball.position) >= r - turn_in_a_step

@@ -8,7 +8,7 @@ import math
 import pytest
 
 import ballpit
-from ballpit.physics.settings import CONTACT_SLOP, OVERLAP_TOLERANCE
+from ballpit.physics.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
 
 G = 9.81
 
@@ -50,5 +50,5 @@ def test_a_ball_rolling_fast_just_above_a_turning_plank_lands_in_few_intervals_a
     for _ in range(hz // 2):
         world.step(1 / hz)
         assert world.profile.intervals <= 3
-        assert plank.signed_distance(ball.position) - r >= -OVERLAP_TOLERANCE
+        assert plank.signed_distance(ball.position) - r >= -PENETRATION_TOLERANCE
     assert plank.signed_distance(ball.position) - r < CONTACT_SLOP  # it landed and stays on the plank

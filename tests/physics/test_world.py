@@ -188,3 +188,12 @@ def test_a_nan_written_straight_into_the_arrays_is_refused_by_name_before_steppi
     with pytest.raises(ValueError, match=r"sphere #1 has a non-finite velocity"):
         world.step(0.01)
     assert world.time == 0.0
+
+
+def test_a_pair_touches_within_ten_micrometres_or_a_thousandth_of_the_smallest_radius():
+    world = ballpit.World()
+    assert world.model.contact_slop() == 1e-5  # no balls: CONTACT_SLOP
+    world.add_sphere(radius=0.5)
+    assert world.model.contact_slop() == 1e-5
+    world.add_sphere(position=(3, 0, 0), radius=1e-4)
+    assert world.model.contact_slop() == pytest.approx(1e-7)

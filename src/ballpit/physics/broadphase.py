@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import exact
-from .settings import ALL_PAIRS_UP_TO, DENSE_CELLS_PER_BALL
+from .settings import ALL_PAIRS_UP_TO, CELL_PER_MEDIAN_BOX, DENSE_CELLS_PER_BALL
 
 # The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
 _OFFSETS = np.array(
@@ -74,9 +74,7 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
         return i[hit], j[hit]
     # the largest side of each box, axis by axis on columns (a max is exact, in any order)
     extent = np.maximum(np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1]), hi[:, 2] - lo[:, 2])
-    # The smallest cell that still holds every box keeps the fewest boxes per cell to test: in a packed
-    # pile, a cell of twice the median box would hold ~8× as many.
-    cell = min(2.0 * float(np.median(extent)), float(extent.max()))
+    cell = min(CELL_PER_MEDIAN_BOX * float(np.median(extent)), float(extent.max()))
     big = extent > cell
     small = np.flatnonzero(~big)
     pairs_i, pairs_j = [], []

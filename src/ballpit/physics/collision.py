@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .settings import TINY
+
 
 def closest_point_on_planes(
     points: np.ndarray,
@@ -55,9 +57,9 @@ def sphere_plane(
     plane_normal = normal[plane]
     signed = np.einsum("ij,ij->i", delta, plane_normal)
     in_plane = dist - np.abs(signed)  # zero when the closest point is on the face, not an edge or corner
-    on_face = in_plane <= 1e-12 * np.maximum(dist, 1.0)
+    on_face = in_plane <= TINY * np.maximum(dist, 1.0)
     crossed = on_face & (signed * side <= 0.0)
-    safe = np.where(dist > 1e-12, dist, 1.0)
+    safe = np.where(dist > TINY, dist, 1.0)
     normal = np.where(on_face[:, None], side[:, None] * plane_normal, delta / safe[:, None])
     gap = np.where(crossed, -np.abs(signed), dist) - radius[sphere]
     return gap, normal, point
@@ -70,8 +72,8 @@ def sphere_sphere(
     xj = np.take(x, j, axis=0)  # rows by index: several times faster than x[j]
     delta = np.take(x, i, axis=0) - xj
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
-    coincident = dist <= 1e-12
-    normal = delta / np.maximum(dist, 1e-12)[:, None]
+    coincident = dist <= TINY
+    normal = delta / np.maximum(dist, TINY)[:, None]
     if coincident.any():  # coincident centres have no normal; pick +y so the pair separates vertically
         normal[coincident] = (0.0, 1.0, 0.0)
     rj = radius[j]

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .settings import NO_ZERO_DIVIDE
+
 
 @dataclass
 class Impulses:
@@ -102,7 +104,7 @@ def inverse_effective_masses(
     lever-arm lengths: how much a unit impulse changes the normal speed, the slip and the spin."""
     inv_n = inv_mass_a + inv_mass_b
     inv_t = inv_mass_a + arm_a**2 * inv_inertia_a + inv_mass_b + arm_b**2 * inv_inertia_b
-    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, 1e-300)
+    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, NO_ZERO_DIVIDE)
     return inv_n, inv_t, inv_r
 
 
@@ -188,7 +190,7 @@ def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     ``candidate`` is scaled in place (every caller passes a temporary) and returned."""
     x, y, z = candidate[..., 0, :], candidate[..., 1, :], candidate[..., 2, :]
     length = x * x + y * y + z * z
-    length += 1e-300  # no 0/0 at zero
+    length += NO_ZERO_DIVIDE
     np.sqrt(length, out=length)
     scale = np.minimum(limit / length, 1.0)
     candidate *= scale[..., None, :]

@@ -13,7 +13,7 @@ from . import exact
 from .energy_guard import EnergyGuards
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
-from .settings import CROWD_LIMIT, SLOWEST_TURN, SOLVER_ITERATIONS
+from .settings import CONTACT_SLOP, CROWD_LIMIT, SLOP_PER_RADIUS, SLOWEST_TURN, SOLVER_ITERATIONS
 from .state import Columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
@@ -117,6 +117,12 @@ class Model:
         x, y, z = spin[:, 0], spin[:, 1], spin[:, 2]
         still = (x * x + y * y) + z * z < SLOWEST_TURN * SLOWEST_TURN
         return np.where(still[:, None], 0.0, spin) if still.any() else spin
+
+    def contact_slop(self) -> float:
+        """The gap (m) under which a pair is touching in this world, for every stage of the step:
+        CONTACT_SLOP, or SLOP_PER_RADIUS of the smallest ball's radius if that is less."""
+        radius = self.spheres.radius
+        return min(CONTACT_SLOP, SLOP_PER_RADIUS * float(radius.min())) if len(radius) else CONTACT_SLOP
 
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""

@@ -22,9 +22,8 @@ from .settings import (
     BROAD_PHASE_MARGIN,
     BROAD_PHASE_REACH,
     BROAD_PHASE_STEPS,
-    CONTACT_SLOP,
     ESCAPE_CHUNK,
-    SLOP_PER_RADIUS,
+    TINY,
 )
 from .state import State, V, X, shallow_copy
 
@@ -130,13 +129,6 @@ def _norm(a: np.ndarray, scratch: np.ndarray, out: np.ndarray) -> np.ndarray:
     return np.sqrt(out, out=out)
 
 
-def contact_slop(model: Model) -> float:
-    """The gap (m) under which a pair counts as touching in this world: CONTACT_SLOP, or
-    SLOP_PER_RADIUS of the smallest ball's radius if that is less."""
-    radius = model.spheres.radius
-    return min(CONTACT_SLOP, SLOP_PER_RADIUS * float(radius.min())) if len(radius) else CONTACT_SLOP
-
-
 class PairCache:
     """The kept pairs between steps. ``for_step`` reuses them while they still cover every path;
     ``renew`` replaces them when a path changes inside a step (a bounce or a contact force).
@@ -235,14 +227,14 @@ def find_pairs(
     accel_t, free_t = accel.T, free.T
     scratch = np.empty((3, n))
     speed = _norm(v, scratch, np.empty(n))
-    horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, 1e-12), h, max(h, ahead))
+    horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, TINY), h, max(h, ahead))
     now = path.path_end(x, v, accel_t, h)
     later = path.path_end(x, v, free_t, horizon)
     # how far the paths can stray from their chords, over this step and over the horizon
     free_norm = _norm(free_t, scratch, np.empty(n))
     accel_norm = free_norm if accel is free else _norm(accel_t, scratch, np.empty(n))
     sag = path.cover_sag(accel_norm, h) + path.cover_sag(free_norm, horizon)
-    pad = radius + sag + BROAD_PHASE_MARGIN * radius + contact_slop(model)
+    pad = radius + sag + BROAD_PHASE_MARGIN * radius + model.contact_slop()
     lo = np.minimum(x, now)
     np.minimum(lo, later, out=lo)
     hi = np.maximum(x, now, out=now)

@@ -16,14 +16,14 @@ from .contacts import ContactPoints
 from .ends import Ends
 from .model import Model
 from .rows import ContactRows
-from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, OVERLAP_TOLERANCE, PENETRATION_SWEEPS
+from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, PENETRATION_SWEEPS, PENETRATION_TOLERANCE
 from .state import State, X, with_static
 
 
 def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
     """Move overlapping balls apart along the contact normals (positions only), never through a plane."""
     radius = model.spheres.radius
-    tolerance = min(OVERLAP_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
+    tolerance = min(PENETRATION_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
     if not np.any(c.gap < -tolerance):
         return
     x = state.body[:, X]

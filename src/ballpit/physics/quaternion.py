@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import exact
+from .settings import ANTIPARALLEL
 
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -68,7 +69,7 @@ def from_up_to(normal: np.ndarray) -> np.ndarray:
     n = np.asarray(normal, float)
     up = np.array([0.0, 1.0, 0.0])
     d = float(exact.dot(up, n))
-    if d < -1.0 + 1e-12:
+    if d < -1.0 + ANTIPARALLEL:
         return np.array([1.0, 0.0, 0.0, 0.0])
     # q = (up × n, 1 + up·n) normalised is the half-angle form of the rotation between them.
     return normalize(np.concatenate((np.cross(up, n), [1.0 + d])))

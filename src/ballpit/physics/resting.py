@@ -18,7 +18,7 @@ from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows, rows_at_end
-from .settings import HOLD_PASSES, HOLD_SINK, JACOBI_FROM, WARM_START_SPAN
+from .settings import HOLD_PASSES, HOLD_SINK, JACOBI_FROM, NEW_DIRECTION, WARM_START_SPAN
 from .state import State, V, W, shallow_copy, with_static
 
 
@@ -276,7 +276,7 @@ def _plane_bases(rows: ContactRows, held: np.ndarray, pushing: np.ndarray) -> tu
         k = slot[rows.a[pushing[group]]]
         u = _off(basis[k], rows.normal[pushing[group]])
         length = exact.norm(u)
-        ok = (length > 1e-6) & (count[k] < 3)
+        ok = (length > NEW_DIRECTION) & (count[k] < 3)
         k = k[ok]
         basis[k, count[k]] = u[ok] / length[ok, None]
         count[k] += 1

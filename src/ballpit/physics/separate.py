@@ -22,7 +22,7 @@ import numpy as np
 from . import energy_guard, penetration
 from .model import Model
 from .resting import WarmStart
-from .settings import MAX_PUSH, SEPARATE_SWEEPS, SLOP
+from .settings import MAX_PUSH, PENETRATION_TOLERANCE, SEPARATE_REACH, SEPARATE_SWEEPS, SLOP, SLOP_RETURN
 from .state import State, X, with_static
 
 if TYPE_CHECKING:
@@ -42,12 +42,10 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
         np.minimum(*(model.spheres.radius[e] for e in (c.a, np.minimum(c.b, n_balls - 1)))),
     )
     made = s - np.minimum(c.gap + MAX_PUSH * dt, -slop)
-    if not (made < -penetration.OVERLAP_TOLERANCE).any():
+    if not (made < -PENETRATION_TOLERANCE).any():
         return s
-    made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -0.8 * slop), made)
-    # only the contacts a move of up to twice the deepest deficit could reach take part: the others,
-    # farther apart than that, cannot be closed by moving these apart
-    part = np.flatnonzero(made < -2.0 * made.min())
+    made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -SLOP_RETURN * slop), made)
+    part = np.flatnonzero(made < -SEPARATE_REACH * made.min())
     pos = with_static(body[:, X])
     normals = np.take(c.normal.T, part, axis=1).T  # laid out as (3, K) columns, as separate reads them
     penetration.separate(
@@ -93,7 +91,7 @@ def planes_win(f: SoftFrame, model: Model, state: State) -> None:
         u = rows.surface[on]
         s -= (u[:, 0] * nrm[:, 0] + u[:, 1] * nrm[:, 1] + u[:, 2] * nrm[:, 2]) * dt
     deficit = np.maximum(np.minimum(c.gap[on], -SLOP * model.spheres.radius[a]) - s, 0.0)
-    if not (deficit > penetration.OVERLAP_TOLERANCE).any():
+    if not (deficit > PENETRATION_TOLERANCE).any():
         return
     new = body[:, X].copy()
     lift = np.zeros((len(body), 3))

@@ -32,8 +32,34 @@ SLOWEST_TURN = math.sqrt(sys.float_info.min)
 # Balls closer than this (m) are in contact: the solver holds them, time of impact stops here …
 CONTACT_SLOP = 1e-5
 # … or closer than this fraction of the smallest ball's radius, if that is less: a fixed 10 µm let a
-# 100 nm ball touch every wall of a 20 µm box at once, and leave it.
+# 100 nm ball touch every wall of a 20 µm box at once, and leave it. One definition of touching for
+# every stage of the step: ``Model.contact_slop``.
 SLOP_PER_RADIUS = 1e-3
+
+# The overlap (m) a world may start with: a scene's balls may press this far into each other or a plane
+# (the default of its ``[world] overlap_tolerance``, README; scene/schema.py reads it from here). A
+# micrometre: nothing shows, and the step moves it apart as it does any overlap deeper than
+# PENETRATION_TOLERANCE.
+OVERLAP_TOLERANCE = 1e-6
+
+# --- Zero, for lengths, speeds and directions -------------------------------------------------------
+
+# Lengths (m) and speeds (m/s) at or below this are zero where a direction or a ratio is formed from
+# them: two ball centres this close are coincident (their contact normal is taken as +y), a ball's
+# centre this close to a plane's face (relative to its distance, beyond a metre) is on the face (the
+# normal is the plane's), a ball slower than this keeps its pairs the longest (no division by its
+# speed), and an argument shorter than this is a zero vector. A thousandth of a nanometre: rounding,
+# at the sizes a world holds (a radius is at least 1e-9 m).
+TINY = 1e-12
+# A unit normal whose dot product with +y is within this of −1 is −y: the shortest turn from +y is
+# then not defined, and the plane is turned 180° about x (dimensionless).
+ANTIPARALLEL = 1e-12
+# Gram–Schmidt over the planes holding a ball (resting.hold_by_planes): a normal whose part off the
+# directions already found is shorter than this (a unit vector's, dimensionless) adds none.
+NEW_DIRECTION = 1e-6
+# Added to a squared length (or an inverse inertia sum) before it divides: no 0/0 where it is zero.
+# Far below any impulse², inertia⁻¹ or length² a step forms, and far above the smallest double.
+NO_ZERO_DIVIDE = 1e-300
 
 # --- Broad phase (pairs.py, broadphase.py) ------------------------------------------------------------
 
@@ -49,6 +75,10 @@ BROAD_PHASE_MARGIN = 0.1
 DENSE_CELLS_PER_BALL = 16
 # Up to this many boxes, testing every pair at once costs fewer array operations than the grid.
 ALL_PAIRS_UP_TO = 48
+# The grid's cell is this many times the median box's largest side (or the largest box, if smaller):
+# the smallest cell that still holds most boxes whole keeps the fewest boxes per cell to test (in a
+# packed pile a cell of twice the median box holds ~8× fewer than one as large as the largest box).
+CELL_PER_MEDIAN_BOX = 2.0
 # Balls the escape test takes at a time: its scratch stays in the cache, and it stops at the first escape.
 ESCAPE_CHUNK = 8192
 
@@ -79,11 +109,20 @@ DEEP_OVERLAP = 0.25
 # --- The soft step of a crowded step (softstep.py) -------------------------------------------------
 
 # Contact stiffness (Hz) and damping ratio of an overlap's soft spring, and the fastest it pushes
-# overlapping balls apart (m/s): Box2D v3's defaults. The stiffness is capped at a quarter of the
-# substep rate; contacts with a plane take twice it (Box2D's static softness).
+# overlapping balls apart (m/s): Box2D v3's defaults.
 CONTACT_HERTZ = 60.0
 DAMPING_RATIO = 10.0
 MAX_PUSH = 3.0
+# The stiffness is capped at this fraction of the substep rate (Hz per Hz, 1/h): a spring much stiffer
+# than its substeps can follow overshoots within one (Box2D v3's cap, a quarter) …
+SOFT_RATE_CAP = 0.25
+# … and contacts with a plane take this many times the stiffness of those between balls (Box2D's
+# static softness: a plane does not give way, so its contacts may be stiffer).
+PLANE_STIFFNESS = 2.0
+# A contact takes a share of its balls' mass in a substep's solve when it is pressed already or would
+# close its gap within this many substeps at its normal speed (a speculative contact still far from
+# closing takes none, so it does not soften the ones that carry the load).
+PUSH_AHEAD = 2.0
 # Overlaps up to this fraction of the smaller radius are left to the soft spring (which holds a
 # resting pile with some give); only deeper ones are moved apart by positions after the substeps.
 # A soft contact rests at the overlap its load F needs, s_eq = F·(1/m_a + 1/m_b)/ω² (ω = 2π·60 Hz:
@@ -92,6 +131,12 @@ MAX_PUSH = 3.0
 # never stands still. So the spring remembers how far it was moved apart (``WarmStart.apart``, up to
 # s_eq) and keeps pushing as if that overlap were still there: it holds the load at the slop.
 SLOP = 0.01
+# Overlaps deeper than the slop are moved back to this fraction of it, not to it, so they are not
+# caught again next frame (separate.py) …
+SLOP_RETURN = 0.8
+# … and only the contacts a move of up to this many times the deepest deficit could reach take part:
+# the others, farther apart than that, cannot be closed by moving these apart.
+SEPARATE_REACH = 2.0
 # Jacobi sweeps per substep: with the bias, then without it (relax). Friction and rolling resistance
 # are updated in the last sweep of each; the others update the normal impulses alone. Relaxing with
 # 4 instead of 2 (three normal-only sweeps, cheap) took pile.toml's worst overlap while landing at
@@ -133,8 +178,8 @@ MAX_ADVANCE_STEPS = 48
 
 # --- Penetration (penetration.py) -------------------------------------------------------------------
 
-# Overlaps shallower than this (m) are left alone: rounding, not penetration …
-OVERLAP_TOLERANCE = 1e-7
+# Overlaps shallower than this (m) are left alone by the step: rounding, not penetration …
+PENETRATION_TOLERANCE = 1e-7
 # … or than this fraction of the smallest ball's radius, if that is less (a 100 nm ball could otherwise
 # sink its whole radius into a wall).
 OVERLAP_PER_RADIUS = 1e-5

@@ -26,7 +26,7 @@ import numpy as np
 from .contacts import SPHERE_SPHERE, ContactPoints
 from .forces import ConstantPerBall
 from .model import Model
-from .settings import CONTACT_SLOP, SLEEP_SPEED, TIME_TO_SLEEP
+from .settings import SLEEP_SPEED, TIME_TO_SLEEP
 from .state import Q, Sleep, State, V, W, X
 
 
@@ -108,10 +108,10 @@ def may_fall_asleep(sleep: Sleep, dt: float) -> bool:
     return bool(((sleep.rest + dt >= TIME_TO_SLEEP) & ~sleep.asleep).any())
 
 
-def links(c: ContactPoints, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The ball–ball pairs (a, b) of ``c`` that join islands: those touching or within reach of each
-    other (``reach``, a mask over ``c``), whose balls would wake each other."""
-    linked = (c.kind == SPHERE_SPHERE) & (reach | (c.gap < CONTACT_SLOP))
+def links(c: ContactPoints, reach: np.ndarray, touching: float) -> tuple[np.ndarray, np.ndarray]:
+    """The ball–ball pairs (a, b) of ``c`` that join islands: those touching (closer than ``touching``)
+    or within reach of each other (``reach``, a mask over ``c``), whose balls would wake each other."""
+    linked = (c.kind == SPHERE_SPHERE) & (reach | (c.gap < touching))
     return c.a[linked], c.other[linked]
 
 

@@ -53,7 +53,17 @@ from .model import Model
 from .profile import Stage, StepProfile
 from .resting import WarmStart
 from .rows import contact_rows
-from .settings import CONTACT_HERTZ, DAMPING_RATIO, LEVEL, MAX_PUSH, RELAX_SWEEPS, SOLVE_SWEEPS
+from .settings import (
+    CONTACT_HERTZ,
+    DAMPING_RATIO,
+    LEVEL,
+    MAX_PUSH,
+    PLANE_STIFFNESS,
+    PUSH_AHEAD,
+    RELAX_SWEEPS,
+    SOFT_RATE_CAP,
+    SOLVE_SWEEPS,
+)
 from .state import Q, State, V, W, X
 
 
@@ -157,10 +167,10 @@ class SoftFrame:
         self.on_plane = self.rows.b == n_balls
         # the surface's own speed along the normal (moving planes), to move their side of s
         self.surface_n = dot(k.surface, k.n) if k.surface is not None else None
-        hertz = min(CONTACT_HERTZ, 0.25 / h)
+        hertz = min(CONTACT_HERTZ, SOFT_RATE_CAP / h)
         self.ball_soft, self.plane_soft = (
             softness(hertz, DAMPING_RATIO, h),
-            softness(2.0 * hertz, DAMPING_RATIO, h),
+            softness(PLANE_STIFFNESS * hertz, DAMPING_RATIO, h),
         )
         self.vn_start = _normal_speed(k, vw)  # recorded at the frame's start, for the restitution pass
         self.keys = c.keys()
@@ -210,7 +220,7 @@ def solve(f: SoftFrame, i: int) -> None:
     gap."""
     k, vw, h = f.k, f.vw, f.h
     s = f.separation(i * h)
-    k.split((f.normal > 0.0) | (s + 2.0 * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
+    k.split((f.normal > 0.0) | (s + PUSH_AHEAD * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
     speculative = s > 0.0
     target = np.where(speculative, -s / h, np.minimum(-f.soft("bias_rate") * (s - f.apart), MAX_PUSH))
     scale = np.where(speculative, 1.0, f.soft("mass_scale"))

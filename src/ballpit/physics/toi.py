@@ -17,7 +17,6 @@ import numpy as np
 from . import collision, exact, moving_planes
 from .contacts import SPHERE_PLANE, ContactPoints
 from .model import Model
-from .pairs import contact_slop
 from .settings import IMPACT_OVERLAP, LEAP_AFTER, MAX_ADVANCE_STEPS
 from .state import State, V, X, with_static
 
@@ -74,7 +73,7 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     IMPACT_OVERLAP of the smallest radius (removed next interval by moving positions). A lone impact is
     always met exactly.
     """
-    slop = contact_slop(model)
+    slop = model.contact_slop()
     when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop)
     hit = np.isfinite(when)
     if not hit.any():
@@ -104,7 +103,7 @@ def meetings(
     """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
     ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
     all (their indices into ``c``)."""
-    apart = np.flatnonzero(c.gap >= contact_slop(model))
+    apart = np.flatnonzero(c.gap >= model.contact_slop())
     none = np.zeros(0)
     if apart.size == 0:
         return none, none, apart
@@ -212,7 +211,7 @@ def threatened(model: Model, state: State, c: ContactPoints, accel: np.ndarray, 
     bounded as in ``next_impact``). A (N,) mask."""
     n = model.spheres.count
     hit = np.zeros(n + 1, bool)
-    apart = np.flatnonzero(c.gap >= contact_slop(model))
+    apart = np.flatnonzero(c.gap >= model.contact_slop())
     if apart.size:
         body, path = state.body, model.integrator
         speed = np.append(np.linalg.norm(body[:, V], axis=1), 0.0)

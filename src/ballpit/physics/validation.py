@@ -9,6 +9,7 @@ import numpy as np
 
 from . import exact
 from . import quaternion as rotations
+from .settings import TINY
 
 # What the engine can step: far enough inside float64 that squares, products and sums of these never
 # overflow or underflow (a speed of 1e154 m/s once overflowed v² in the time of impact and hung a step).
@@ -80,7 +81,7 @@ def unit_vector(name: str, value: object) -> np.ndarray:
     if biggest > 1.0:
         v = v / biggest
     norm = float(exact.norm(v))
-    if norm < 1e-12:
+    if norm < TINY:
         raise ValueError(f"{name} must not be a zero vector, got {value!r}")
     return v / norm
 
@@ -92,7 +93,7 @@ def quaternion(name: str, value: object) -> np.ndarray:
     if biggest > 1.0:
         q = q / biggest
     norm = float(exact.norm(q))
-    if norm < 1e-12:
+    if norm < TINY:
         raise ValueError(f"{name} must not be a zero quaternion, got {value!r}")
     return q / norm
 
@@ -213,7 +214,7 @@ def balls(
     q = rows["orientation"]
     q = q / np.maximum(np.abs(q).max(axis=1, keepdims=True), 1.0)  # huge components keep their turn
     qnorm = np.linalg.norm(q, axis=1)
-    if np.any(qnorm < 1e-12):
+    if np.any(qnorm < TINY):
         raise ValueError("orientation must not be a zero quaternion")
     rows["orientation"] = q / qnorm[:, None]
     hollow_in = np.asarray(hollow)

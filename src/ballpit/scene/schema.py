@@ -12,6 +12,7 @@ import inspect
 from collections.abc import Callable
 
 from ..physics import DEFAULT_TIMESTEP, INTEGRATOR_NAMES, World
+from ..physics.settings import OVERLAP_TOLERANCE as OVERLAP_TOLERANCE  # [world] overlap_tolerance
 
 
 def _defaults(function: Callable, names: tuple[str, ...]) -> dict[str, object]:
@@ -67,10 +68,10 @@ GRID_SEED = 0
 MAX_BALLS = 1_000_000  # in the whole scene, spheres and grids together
 
 # Balls or a ball and a plane may touch at the start (a cradle, a ball resting on the floor), but not
-# interpenetrate by more than this, unless [world] overlap_tolerance says otherwise: a scene saved from
-# a running world (Ctrl+S) sets it, since balls at rest press a little into each other and into the
-# floor (about 4e-5 m between the 10 cm balls of pile.toml after 3 s).
-OVERLAP_TOLERANCE = 1e-6  # m
+# interpenetrate by more than OVERLAP_TOLERANCE (1e-6 m, defined with the physics' other tolerances in
+# physics/settings.py), unless [world] overlap_tolerance says otherwise: a scene saved from a running
+# world (Ctrl+S) sets it, since balls at rest press a little into each other and into the floor (about
+# 4e-5 m between the 10 cm balls of pile.toml after 3 s).
 
 WORLD_KEYS = (
     "gravity",

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 import ballpit
 from ballpit.physics.step import Plan, Strategy, plan
@@ -51,4 +52,17 @@ def test_more_meetings_than_the_crowd_limit_make_a_soft_frame():
     world.crowd_limit = 3
     assert planned(world) == SPLIT
     world.crowd_limit = 2
+    assert planned(world) == Plan.soft(1)
+
+
+def test_touching_is_the_worlds_own_slop_for_the_crowd_test_too():
+    # 100 µm balls 5 µm apart: apart for every stage, since a pair touches within a thousandth of the
+    # smallest radius (0.1 µm) when that is under CONTACT_SLOP (10 µm); at rest, nothing meets
+    world = pile_on_a_floor(side=8, r=1e-4, gravity=(0, 0, 0))
+    world.spheres.positions[:] *= 1.05  # every gap 5 % of a radius, 5 µm
+    world.spheres.positions[:, 1] += 1.0  # off the floor
+    assert world.model.contact_slop() == pytest.approx(1e-7)
+    assert planned(world) == SPLIT
+    world.spheres.positions[:] /= 1.05  # touching again (gap 0): the heap is a soft frame
+    world.spheres.positions[:, 1] -= 1.0 / 1.05
     assert planned(world) == Plan.soft(1)

@@ -48,8 +48,8 @@ def prepare(
     state = parts.state
     steppable.reject_unsteppable_state(state.body)
     planes = steppable.reject_bad_planes(model.planes, state.planes, good_planes)
-    threshold = model.restitution_threshold_for(dt)
-    return Step(model, parts, workspace, dt, threshold, EventLog(), StepProfile(), began, planes)
+    threshold, touching = model.restitution_threshold_for(dt), model.contact_slop()
+    return Step(model, parts, workspace, dt, threshold, touching, EventLog(), StepProfile(), began, planes)
 
 
 def solve(step: Step, awake: Awake, chosen: Plan, checkpoint: Checkpoint) -> Strategy:

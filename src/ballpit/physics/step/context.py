@@ -33,6 +33,7 @@ class Step:
     workspace: Workspace
     dt: float
     restitution_threshold: float  # m/s, approach speed below which nothing bounces
+    touching: float  # m, the gap under which a pair is touching (Model.contact_slop)
     events: EventLog
     profile: StepProfile
     began: float  # perf_counter() when the step began

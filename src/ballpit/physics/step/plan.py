@@ -16,7 +16,7 @@ import numpy as np
 from .. import moving_planes
 from ..contacts import SPHERE_PLANE, ContactPoints
 from ..profile import Stage
-from ..settings import CONTACT_SLOP, CROWD_OVERLAP, CROWD_PAIRS, SPECULATIVE_REACH
+from ..settings import CROWD_OVERLAP, CROWD_PAIRS, SPECULATIVE_REACH
 from ..state import V, with_static
 from .collide import Collision, Motion
 from .context import Step
@@ -62,7 +62,7 @@ def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
     CROWD_PAIRS kept pairs or more (a pile), any meeting or touching contact, and so does any overlap
     deeper than CROWD_OVERLAP of a radius (``model.crowd_limit`` inf: never).
     """
-    dt, model = step.dt, step.model
+    dt, model, touching = step.dt, step.model, step.touching
     if len(c) == 0:  # nothing near anything (free flight): nothing can meet
         return False
     many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
@@ -75,10 +75,10 @@ def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
         return False
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
-    meetings = np.count_nonzero((c.gap >= CONTACT_SLOP) & (ahead < CONTACT_SLOP))
+    meetings = np.count_nonzero((c.gap >= touching) & (ahead < touching))
     # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
     # soft step it landed in, not alternately in the two
-    return meetings > (0 if many else model.crowd_limit) or (many and bool((c.gap < CONTACT_SLOP).any()))
+    return meetings > (0 if many else model.crowd_limit) or (many and bool((c.gap < touching).any()))
 
 
 def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray:
@@ -86,7 +86,7 @@ def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray) -> np.nda
     (by the same bound the time of impact uses), touching ones included."""
     dv, da = _relative_motion(step, c, accel)
     closing = step.model.integrator.closing_speed_bound(dv, da, step.dt) * step.dt
-    return c.gap < CONTACT_SLOP + SPECULATIVE_REACH * closing
+    return c.gap < step.touching + SPECULATIVE_REACH * closing
 
 
 def _relative_motion(step: Step, c: ContactPoints, accel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -51,7 +51,7 @@ def wake(step: Step) -> Awake:
             with prof.stage(Stage.SLEEP):
                 reach = speculative_reach(step, collision.contacts, motion.unheld)
         with prof.stage(Stage.SLEEP):
-            links = sleeping.links(collision.contacts, reach)
+            links = sleeping.links(collision.contacts, reach, step.touching)
     if model.sleep and len(step.warm.asleep[0]):
         with prof.stage(Stage.SLEEP):
             step.warm.wake(sleep.asleep)  # the pairs of woken islands start from what they held

@@ -19,7 +19,6 @@ from ..model import Model
 from ..profile import Stage
 from ..settings import (
     BROAD_PHASE_STEPS,
-    CONTACT_SLOP,
     DEEP_OVERLAP,
     RETRIES,
     SPECULATIVE_REACH,
@@ -74,7 +73,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     pull = np.append(np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2]), 0.0)
     contacts = collision.take()
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
-    solved = (contacts.gap < CONTACT_SLOP + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
+    solved = (contacts.gap < step.touching + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
     c = contacts.subset(solved)
     # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.Contacts.n is

@@ -14,7 +14,7 @@ import numpy as np
 from .. import impacts, narrowphase, penetration, resting, rows, toi
 from ..contacts import ContactPoints
 from ..forces import ConstantPerBall, free_acceleration
-from ..pairs import KeptPairs, contact_slop
+from ..pairs import KeptPairs
 from ..profile import Stage
 from ..settings import BROAD_PHASE_STEPS, MAX_INTERVALS
 from ..state import V, W
@@ -35,7 +35,7 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         first = step.intervals == 0
         if not first:
             contacts = measure(step, pairs)
-        touching = contacts.subset(contacts.gap < contact_slop(model))
+        touching = contacts.subset(contacts.gap < step.touching)
         with prof.stage(Stage.CONTACT_ROWS):
             batch = rows.contact_rows(model, state, touching)
         with prof.stage(Stage.PENETRATION):
