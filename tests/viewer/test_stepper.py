@@ -181,16 +181,15 @@ def _shown_speed(physics: PhysicsThread, until: float) -> float:
 
 
 @pytest.mark.slow
-def test_a_dear_stretch_after_a_cheap_one_is_shown_in_real_time_from_the_steps_taken_ahead(monkeypatch):
+def test_a_dear_stretch_after_a_cheap_one_is_shown_in_real_time_from_the_steps_taken_ahead():
     # The first second costs nothing, the next 0.4 s 1.5x real time, then nothing again: on average
     # cheaper than real time, as pile.toml's fall and landing are. Running ahead, what the window shows
     # keeps real time throughout; stepping on the wall clock alone, the dear stretch plays slowly.
     speeds, ahead = {}, stepper.LEAD_SECONDS
     for lead in (ahead, 0.0):
-        monkeypatch.setattr(stepper, "LEAD_SECONDS", lead)
         sim = Simulation(line_of_balls(3))
         _cost(sim, 1.0, 1.4, 1.5)
-        physics = PhysicsThread(sim)
+        physics = PhysicsThread(sim, lead=lead)
         try:
             physics.submit(lambda s: s.start())
             physics.run_free()
@@ -245,3 +244,16 @@ def test_a_record_closed_while_the_run_is_ahead_ends_at_the_state_the_window_sho
     assert steps == shown.step < sim.timeline.history.current  # the steps taken ahead are left out
     with np.load(tmp_path / "run.npz") as run:
         assert run["time"].max() == shown.time
+
+
+def test_the_lead_and_switch_interval_come_from_the_environment_only_where_the_viewer_starts_the_thread():
+    defaults = {"lead": stepper.LEAD_SECONDS, "switch_interval": stepper.SWITCH_INTERVAL}
+    assert stepper.tuning_from({}) == defaults
+    tuned = stepper.tuning_from({"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002"})
+    assert tuned == {"lead": 0.0, "switch_interval": 0.002}
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim, **tuned)
+    try:
+        assert physics.lead == 0.0 and not physics._may_run_ahead()  # held to the wall clock
+    finally:
+        physics.stop()

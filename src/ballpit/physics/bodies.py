@@ -19,8 +19,8 @@ from .model import Model
 from .state import Columns, Q, State, V, W, X
 
 
-class World(Protocol):
-    """What a view reads and writes: the world's model and state (``world.World`` has both). A
+class Viewed(Protocol):
+    """What a view reads and writes: a world's model and state (``world.World`` has both). A
     protocol, so this module need not import the facade that imports it."""
 
     model: Model
@@ -85,7 +85,7 @@ class _Body:
 
     __slots__ = ("_world", "index")
 
-    def __init__(self, world: World, index: int) -> None:
+    def __init__(self, world: Viewed, index: int) -> None:
         self._world = world
         self.index = index
 
@@ -224,7 +224,7 @@ def _read_only(column: np.ndarray) -> np.ndarray:
 class _Views(Sequence):
     _view: type
 
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: Viewed) -> None:
         self._world = world
 
     def _count(self) -> int:

@@ -106,7 +106,7 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, p
     When the moved balls' kinetic energy cannot pay for the whole lift, ``partly`` moves them only the
     part of the way it pays for, K/ΔU (``new`` changes in place), and stops them: the split step then
     leaves a resting overlap the soft step held (within its slop) as it is, instead of lifting a ball
-    at rest out of it for nothing (pile.toml gained up to 1.7e-5 J a step that way, #24). Without it
+    at rest out of it for nothing (a settled pile gained up to 1.7e-5 J a step that way). Without it
     the balls are moved all the way (the soft step's push-outs, and planes that win).
     """
     if not model.guards.lift:

@@ -184,7 +184,7 @@ def _velocities(rows: ContactRows, v: np.ndarray, w: np.ndarray) -> tuple[np.nda
 def waves_from(
     model: Model,
     rows: ContactRows,
-    k: jacobi.Contacts,
+    k: jacobi.ContactColumns,
     v: np.ndarray,
     vn_start: np.ndarray,
     restitution_threshold: float,
@@ -289,7 +289,7 @@ def _wave_sweeps(
 
 def normal_solve(
     rows: ContactRows,
-    k: jacobi.Contacts,
+    k: jacobi.ContactColumns,
     vw: np.ndarray,
     idx: np.ndarray,
     start: np.ndarray,

@@ -33,7 +33,7 @@ from .rows import ContactRows
 from .settings import ADD_UP_BINS_UP_TO, CONVERGED
 
 
-class Contacts(Ends):
+class ContactColumns(Ends):
     """What the sweeps need of the contacts, gathered once per solve, with vectors as (3, K) rows.
 
     Velocities are the rows of one (6, M) array [v; ω] of just the M balls the contacts touch; ``ends``
@@ -114,7 +114,7 @@ def solve(
     contact's velocity by more than CONVERGED."""
     if len(contacts) == 0:
         return imp
-    c = Contacts(contacts)
+    c = ContactColumns(contacts)
     vw = np.ascontiguousarray(np.hstack((v[c.balls], w[c.balls])).T)  # (6, M)
     # accumulated friction (row 0) and rolling-resistance (row 1) impulses
     tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
@@ -130,7 +130,7 @@ def solve(
 
 
 def sweeps(
-    c: Contacts,
+    c: ContactColumns,
     vw: np.ndarray,
     normal: np.ndarray,
     tangential: np.ndarray | None,
@@ -172,7 +172,9 @@ def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | N
     return model.normal_speed(g[:, : c.k], g[:, c.k :], n, surface)
 
 
-def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray) -> None:
+def apply(
+    c: ContactColumns, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray
+) -> None:
     """Add the impulses ``normal`` (K,) and ``tangential`` (friction, rolling: (2, 3, K)) to both balls
     of every contact (``contact_model``: Δv = ±m⁻¹·(P_n·n + P_t), Δω = I⁻¹·(−ρ·n × P_t ± R));
     ``push`` (6, 2K) is scratch, or (1, 2K) to make and add up the pushes one row at a time."""
@@ -198,7 +200,7 @@ def apply(c: Contacts, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tan
 
 
 def _apply_by_rows(
-    c: Contacts, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray, d_r: np.ndarray
+    c: ContactColumns, vw: np.ndarray, row: np.ndarray, normal: np.ndarray, d_t: np.ndarray, d_r: np.ndarray
 ) -> None:
     """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
     ball, are those of the (6, 2K) block."""
@@ -223,7 +225,7 @@ def _apply_by_rows(
 
 
 def _normal_sweep(
-    c: Contacts,
+    c: ContactColumns,
     vw: np.ndarray,
     push: np.ndarray,
     normal: np.ndarray,
@@ -254,7 +256,7 @@ def _normal_sweep(
 
 
 def _full_sweep(
-    c: Contacts,
+    c: ContactColumns,
     vw: np.ndarray,
     push: np.ndarray,
     normal: np.ndarray,

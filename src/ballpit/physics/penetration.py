@@ -122,7 +122,7 @@ def keep_sides_of_planes(
         crossing = (d0 >= 0.0) != (d1 >= 0.0)
         # nor is a ball moved into a plane, deeper than it touched or overlapped it, by more than
         # HOLD_SINK of its radius: that plane's contact may not be among the interval's touching
-        # ones (it was out of reach before the move), and the ball would fly on into it (#25)
+        # ones (it was out of reach before the move), and the ball would fly on into it
         floor = np.minimum(radius, np.abs(d0)) - HOLD_SINK * radius
         into = ~crossing & (np.where(d0 >= 0.0, d1, -d1) < floor) & deeper
         if not (crossing.any() or into.any()):

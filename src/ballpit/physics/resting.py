@@ -69,7 +69,7 @@ class WarmStart:
     def put_to_sleep(self, asleep: np.ndarray) -> None:
         """Put aside the kept forces of the pairs whose balls are all ``asleep`` (a plane counts as
         asleep): sleeping pairs are not solved, so the next ``keep`` would forget them, and a pile woken
-        with no warm start sags under its own weight and springs back up, gaining energy (#24)."""
+        with no warm start sags under its own weight and springs back up, gaining energy."""
         held = _asleep_pairs(self.keys, asleep)
         if not held.any():
             return
@@ -210,7 +210,7 @@ def hold_by_planes(
     Under a constant force a ball moves h·(v_n0 + v_n1)/2 along a normal over the interval. Gauss–Seidel
     hands momentum through a light ball pressed between a heavy ball and a wall at about
     m_light/m_heavy a sweep, so at a mass ratio of 47 its sweeps left the light ball sinking a quarter of
-    its radius a step, and the heavy ball pushed it through the wall (#25). Such a ball is held:
+    its radius a step, and the heavy ball pushed it through the wall. Such a ball is held:
 
     1. its plane contacts (and those on sleeping balls: every contact whose far side has no inverse
        mass) are driven to their target, the ball alone moving (impulses only added: a hold pushes);

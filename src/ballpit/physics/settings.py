@@ -237,7 +237,7 @@ WARM_START_SPAN = 0.5
 # sleeping ball) it touches by more than this fraction of its radius over one interval, the ball is held
 # by that plane. Gauss–Seidel moves momentum through a light ball between a heavy ball and a wall at
 # about m_light/m_heavy per sweep: at a mass ratio of 47 ten sweeps left a 9.8 mm ball sinking 2.7 mm an
-# interval, and the heavy ball carried it through the wall (#25). A converged solve sinks ~1e-9 radii.
+# interval, and the heavy ball carried it through the wall. A converged solve sinks ~1e-9 radii.
 HOLD_SINK = 0.01
 # Sweeps over a held ball's plane contacts after the hold: exact after one against square walls.
 HOLD_PASSES = 3

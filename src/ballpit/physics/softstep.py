@@ -146,7 +146,7 @@ class SoftFrame:
         self.h = h = dt / substeps
         n_balls = model.spheres.count
         self.rows = contact_rows(model, state, c)
-        k = self.k = jacobi.Contacts(self.rows)
+        k = self.k = jacobi.ContactColumns(self.rows)
         body = state.body
         self.k_balls = k.balls
         m_dyn = int(np.searchsorted(k.balls, n_balls))  # the static row N, if there, is the last column
@@ -317,7 +317,7 @@ def _accelerations(terms, constant, x: np.ndarray, vw: np.ndarray, q: np.ndarray
     return lin.T, ang.T
 
 
-def _normal_speed(k: jacobi.Contacts, vw: np.ndarray) -> np.ndarray:
+def _normal_speed(k: jacobi.ContactColumns, vw: np.ndarray) -> np.ndarray:
     """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
     against a moving plane's surface."""
     return jacobi.normal_speeds(k, vw, k.n, k.surface)
@@ -328,7 +328,7 @@ def _length(a: np.ndarray) -> np.ndarray:
 
 
 def _soft_sweeps(
-    k: jacobi.Contacts,
+    k: jacobi.ContactColumns,
     vw: np.ndarray,
     normal: np.ndarray,
     tangential: np.ndarray,

@@ -28,7 +28,6 @@ class Columns:
     """Named arrays that share a leading capacity dimension and grow together."""
 
     def __init__(self, spec: dict[str, tuple[tuple[int, ...], type]], capacity: int = 16) -> None:
-        self._spec = spec
         self.count = 0
         self.capacity = capacity
         self._arrays = {k: np.zeros((capacity, *shape), dtype) for k, (shape, dtype) in spec.items()}

@@ -85,18 +85,6 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
 
 
-def deep_overlaps(
-    model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float, depth: float
-) -> np.ndarray:
-    """The pairs of ``c`` (not yet touching) that would overlap by more than ``depth`` times the
-    smaller radius within ``h``, as a mask over ``c``."""
-    deep = lambda ra, rb: -depth * np.where(rb > 0.0, np.minimum(ra, rb), ra)  # noqa: E731
-    when, _, pairs = meetings(model, state, c, accel, h, deep)
-    mask = np.zeros(len(c), bool)
-    mask[pairs[np.isfinite(when)]] = True
-    return mask
-
-
 def meetings(
     model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float, target
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -16,6 +16,7 @@ pyglet's loop draws at the rate pacing.py chooses: 60 FPS, or 33 while the physi
 from __future__ import annotations
 
 import copy
+import os
 import sys
 import time
 from collections import deque
@@ -76,7 +77,7 @@ class Viewer:
         from .panel import Panel
         from .renderer import Renderer
         from .screen import ScreenOverlay
-        from .stepper import PhysicsThread
+        from .stepper import PhysicsThread, tuning_from
         from .view_control import ViewControl
         from .watch import Traces
 
@@ -109,7 +110,8 @@ class Viewer:
         self.traces = Traces()
         self.sim.after_step.append(lambda: self.traces.sample(self.sim))
         self.sim.after_reset.append(lambda: self.traces.follow(None))
-        self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
+        tuning = tuning_from(os.environ)  # the one place the environment is read for it
+        self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch, **tuning)
         self.panel = Panel(self)
         self.panel.shown = panel
         self.view.scene_view(self.shown)

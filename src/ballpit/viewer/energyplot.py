@@ -1,7 +1,7 @@
 """The energy trace the panel's plot (P) draws: kinetic, potential and total energy over the last
 ``WINDOW_SECONDS``, one total per integrator with ghosts on.
 
-``EnergyTrace`` keeps one sample per frame (stepping back in the history cuts the samples after the
+``EnergyWindow`` keeps one sample per frame (stepping back in the history cuts the samples after the
 present). No GL here.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 WINDOW_SECONDS = 10.0
 
 
-class EnergyTrace:
+class EnergyWindow:
     """Samples (time, kinetic, potential, total per integrator) over the last ``window`` seconds."""
 
     def __init__(self, window: float = WINDOW_SECONDS) -> None:

@@ -106,7 +106,7 @@ class Shown:
     ghosts: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
     hud: HudFacts | None = None
     bar: Bar | None = None
-    energy: Any = None  # an EnergyTrace copy while the plot is open
+    energy: Any = None  # an EnergyWindow copy while the plot is open
     error: str | None = None
     message: str = ""
     path: Any = None  # the scene file (for the HUD's save/reload messages)

@@ -23,7 +23,7 @@ Two ways to run:
   time, applying the commands first. Tests and scripted runs use it for exact, repeatable frames.
 
 Running ahead. While a live run plays at real speed and nothing is asked of it, the thread does not
-wait for the wall clock: it steps up to LEAD_SECONDS ahead of what the window shows and queues a
+wait for the wall clock: it steps up to ``lead`` (LEAD_SECONDS) ahead of what the window shows and queues a
 ``Shown`` per LEAD_FRAME of simulated time, each due at the wall time its simulated time maps to; the
 window shows the latest one due (``shown``). What a cheap stretch saves pays for a dear one: pile.toml's
 fall costs 2-4 ms a 1/60 s frame and the heaviest part of its landing 18-22 ms, so beside the window
@@ -51,12 +51,11 @@ window, coming back from a GL call, waits at most about a millisecond for the ph
 
 from __future__ import annotations
 
-import os
 import sys
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from .handover import HudFacts, Needs, Shown, capture
@@ -67,13 +66,24 @@ IDLE_HANDOVER = 0.5  # seconds between hand-overs while nothing steps and no com
 IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes it at once)
 BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
 # s of wall time the physics may run ahead of what the window shows while a live run plays (see
-# "Running ahead" above; BALLPIT_LEAD=0 turns it off, for comparisons), and s of simulated time per
-# hand-over meanwhile
-LEAD_SECONDS = float(os.environ.get("BALLPIT_LEAD", "0.5"))
+# "Running ahead" above; 0 turns it off, for comparisons), and s of simulated time per hand-over
+# meanwhile
+LEAD_SECONDS = 0.5
 LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
-SWITCH_INTERVAL = float(os.environ.get("BALLPIT_SWITCH", "0.001"))
+SWITCH_INTERVAL = 0.001
+
+
+def tuning_from(environ: Mapping[str, str]) -> dict[str, float]:
+    """The thread's tuning as a benchmark sets it in the environment (read by the viewer when it starts
+    the thread, and passed in): ``BALLPIT_LEAD`` (s; 0 holds the physics to the wall clock) and
+    ``BALLPIT_SWITCH`` (s), each LEAD_SECONDS and SWITCH_INTERVAL when not set."""
+    return {
+        "lead": float(environ.get("BALLPIT_LEAD", LEAD_SECONDS)),
+        "switch_interval": float(environ.get("BALLPIT_SWITCH", SWITCH_INTERVAL)),
+    }
+
 
 Command = Callable[[Simulation], Any]
 Then = Callable[[Any], None]
@@ -87,8 +97,11 @@ class PhysicsThread:
         sim: Simulation,
         needs: Callable[[], Needs] = Needs,
         watch: Callable[[Simulation], Any] | None = None,
+        lead: float = LEAD_SECONDS,
+        switch_interval: float = SWITCH_INTERVAL,
     ) -> None:
         self.sim = sim
+        self.lead = lead  # s of wall time the run may be stepped ahead of what the window shows
         self.needs = needs  # what the window draws now (asked at each capture)
         self.watch = watch  # the panel's copy of the run, made at each capture (Shown.watch)
         self.lock = threading.Lock()  # held while the World changes: a step, a command, a capture
@@ -116,7 +129,7 @@ class PhysicsThread:
         with self.lock:
             self._shown = self._capture(force_hud=True)
         self._previous_switch = sys.getswitchinterval()
-        sys.setswitchinterval(SWITCH_INTERVAL)
+        sys.setswitchinterval(switch_interval)
         self._thread = threading.Thread(target=self._run, name="ballpit physics", daemon=True)
         self._thread.start()
 
@@ -288,14 +301,14 @@ class PhysicsThread:
         sim = self.sim
         timeline = sim.timeline
         return (
-            LEAD_SECONDS > 0.0
+            self.lead > 0.0
             and sim.phase is Phase.RUNNING
             and timeline.history is not None
             and timeline.replay is None
         )
 
     def _run_ahead(self) -> float:
-        """Step one LEAD_FRAME of simulated time and queue the state, unless the run is LEAD_SECONDS
+        """Step one LEAD_FRAME of simulated time and queue the state, unless the run is ``lead`` seconds
         ahead of what the window shows already; returns how long to wait before the next batch."""
         sim = self.sim
         history = sim.timeline.history
@@ -308,9 +321,9 @@ class PhysicsThread:
         wall0, sim0 = self._base
         shown = min(sim0 + (now - wall0) * scale, sim.world.time)  # the simulated time shown now
         ahead = (sim.world.time - shown) / scale
-        if ahead >= LEAD_SECONDS:
+        if ahead >= self.lead:
             self._count_shown(now, shown)
-            return min(ahead - LEAD_SECONDS + 1e-3, IDLE_WAIT)
+            return min(ahead - self.lead + 1e-3, IDLE_WAIT)
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
         state = self._capture(force_hud=False)
         done = time.perf_counter()

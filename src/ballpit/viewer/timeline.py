@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .energyplot import EnergyTrace
+from .energyplot import EnergyWindow
 from .ghosts import CATCH_UP_STEPS, Ghosts, total_energy
 from .history import History
 from .replay import Replay, Trajectory
@@ -45,7 +45,7 @@ class Timeline:
         self.history: History | None = None
         self.replay: Replay | None = Replay(world, trajectory) if trajectory is not None else None
         self.ghosts: Ghosts | None = None
-        self.energy = EnergyTrace()
+        self.energy = EnergyWindow()
         self._origin: Any = None  # the drop's snapshot, for ghosts started later
 
     # ------------------------------------------------------------------ state

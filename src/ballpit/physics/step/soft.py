@@ -76,7 +76,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     solved = (contacts.gap < step.touching + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
     c = contacts.subset(solved)
-    # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.Contacts.n is
+    # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.ContactColumns.n is
     # then this memory, not a copy of it)
     c.normal = np.asfortranarray(c.normal)
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
