@@ -108,7 +108,7 @@ def best_peer(summaries: list[Summary], n: int) -> Summary | None:
 def table(summaries: list[Summary]) -> list[str]:
     """The summary: one line per engine and size, with its ratio to the best peer at that size."""
     lines = [
-        f"{'balls':>6}  {'engine':9} {'steps/s':>8} {'(min-max)':>15} {'vs best peer':>12} "
+        f"{'balls':>6}  {'engine':9} {'steps/s':>9} {'(min-max)':>19} {'vs best peer':>12} "
         f"{'max overlap':>11} {'max speed at end':>16} {'inside':>11} {'bounce e':>8}"
     ]
     for s in summaries:
@@ -116,7 +116,7 @@ def table(summaries: list[Summary]) -> list[str]:
         ratio = f"{s.median / best.median:.2f}x" if best is not None else ""
         spread = f"({min(s.rates):.1f}-{max(s.rates):.1f})"
         lines.append(
-            f"{s.n:6d}  {s.engine:9} {s.median:8.1f} {spread:>15} {ratio:>12} {s.max_overlap:9.3f} r "
+            f"{s.n:6d}  {s.engine:9} {s.median:9.1f} {spread:>19} {ratio:>12} {s.max_overlap:9.3f} r "
             f"{s.final_speed:12.4f} m/s {f'{s.inside}/{s.n}':>11} {s.bounce:8.3f}"
         )
     return lines
@@ -135,6 +135,7 @@ def figure(summaries: list[Summary]) -> object:
     """Two panels against the number of balls: steps/s (log-log; bars span the rounds) and max overlap."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from matplotlib.ticker import NullLocator
 
     fig = Figure(figsize=(10.0, 4.2), dpi=120, layout="constrained")
     FigureCanvasAgg(fig)
@@ -150,12 +151,15 @@ def figure(summaries: list[Summary]) -> object:
         label = ENGINES[engine].label
         rate.errorbar(ns, medians, yerr=spread, marker="o", capsize=3, label=label)
         overlap.plot(ns, [s.max_overlap for s in runs], marker="o", label=label)
-    rate.set_xscale("log")
+    sizes = sorted({s.n for s in summaries})
+    for ax in (rate, overlap):
+        ax.set_xscale("log")
+        ax.set_xticks(sizes, labels=[f"{n:,}" for n in sizes])
+        ax.xaxis.set_minor_locator(NullLocator())
     rate.set_yscale("log")
     rate.set_xlabel("balls")
     rate.set_ylabel("steps of 1/240 s per second (median)")
     rate.set_title("the landing grid: step rate")
-    overlap.set_xscale("log")
     overlap.set_xlabel("balls")
     overlap.set_ylabel("deepest overlap (fraction of the radius)")
     overlap.set_ylim(bottom=0)
