@@ -23,7 +23,6 @@ import importlib.util
 import json
 import platform
 import resource
-import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -33,6 +32,7 @@ import numpy as np
 
 from .allocator import keep_freed_memory
 from .arguments import OneLineParser, count, one_line, positive
+from .children import run_child
 from .peers.landing import DT, RADIUS, pile_layout
 
 # DT: both engines solve contacts this often; a "step" below is this much simulated time.
@@ -158,27 +158,16 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
 
 
 def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float) -> Result | None:
-    """``measure_one`` in a fresh interpreter; None (after one line on stderr) when it fails.
-
-    The child runs with ``-P``: the current directory is not put on its path, so a folder named
-    ``ballpit`` there (a clone, seen from the folder above it) cannot shadow the installed package.
-    """
-    cmd = [sys.executable, "-P", "-m", "ballpit.bench", "--one", engine, workload, str(n), str(steps)]
-    label = f"{engine} {workload} N={n}"
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        print(f"ballpit bench: {label}: failed: no result within {timeout:g} s", file=sys.stderr)
-        return None
-    try:
-        if done.returncode != 0:
-            raise ValueError
-        return Result(**json.loads(done.stdout.strip().splitlines()[-1]))
-    except (ValueError, IndexError, TypeError):
-        why = [line.strip() for line in done.stderr.splitlines() if line.strip()]
-        reason = one_line(why[-1], limit=300) if why else f"exit status {done.returncode}, no output"
-        print(f"ballpit bench: {label}: failed: {reason}", file=sys.stderr)
-        return None
+    """``measure_one`` in a fresh interpreter (``children.py``); None (after one line on stderr) when
+    it fails."""
+    result = run_child("ballpit.bench", ["--one", engine, workload, str(n), str(steps)], timeout)
+    if isinstance(result, dict):
+        try:
+            return Result(**result)
+        except TypeError:
+            result = f"an unexpected result: {one_line(str(result), limit=200)}"
+    print(f"ballpit bench: {engine} {workload} N={n}: failed: {result}", file=sys.stderr)
+    return None
 
 
 def _table(results: list[Result], reference: dict[tuple[str, int], Result]) -> str:

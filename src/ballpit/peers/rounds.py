@@ -8,13 +8,12 @@ process gives none of them another's caches or heap.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from collections.abc import Callable, Iterator
 from dataclasses import asdict
 
 from ..allocator import keep_freed_memory
 from ..arguments import one_line
+from ..children import run_child
 from .engines import ENGINES
 from .measure import Landed, land
 
@@ -31,24 +30,15 @@ def child_main(argv: list[str]) -> int:
 def land_isolated(
     engine: str, n: int, steps: int, timeout: float, overrides: dict[str, str] | None = None
 ) -> Landed | str:
-    """``land`` in a fresh interpreter: its ``Landed``, or one line saying why it failed.
-
-    ``-P`` keeps the current directory off the child's path, so a folder named ``ballpit`` there (a
-    clone, seen from the folder above it) cannot shadow the installed package.
-    """
+    """``land`` in a fresh interpreter (``children.py``): its ``Landed``, or one line saying why it failed."""
     pairs = [f"{k}={v}" for k, v in (overrides or {}).items()]
-    cmd = [sys.executable, "-P", "-m", "ballpit.peers", engine, str(n), str(steps), *pairs]
+    result = run_child("ballpit.peers", [engine, str(n), str(steps), *pairs], timeout)
+    if isinstance(result, str):
+        return result
     try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return f"no result within {timeout:g} s"
-    try:
-        if done.returncode != 0:
-            raise ValueError
-        return Landed(**json.loads(done.stdout.strip().splitlines()[-1]))
-    except (ValueError, IndexError, TypeError):
-        why = [line.strip() for line in done.stderr.splitlines() if line.strip()]
-        return one_line(why[-1], limit=300) if why else f"exit status {done.returncode}, no output"
+        return Landed(**result)
+    except TypeError:
+        return f"an unexpected result: {one_line(str(result), limit=200)}"
 
 
 def interleaved(
