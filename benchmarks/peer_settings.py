@@ -6,6 +6,7 @@ a radius. The defaults in ``ballpit/peers/mujoco_engine.py`` and ``pybullet_engi
 fastest stable ones found here (docs/benchmarks.md has the figures).
 
     .venv/bin/python benchmarks/peer_settings.py [--balls 1000] [--steps 480] [--rounds 2] [--only mujoco]
+    .venv/bin/python benchmarks/peer_settings.py --numbers 1,7,8,11,12,13   # the iteration counts
 """
 
 import argparse
@@ -22,9 +23,11 @@ TRIED = [
     ("mujoco", "implicitfast, pyramidal, PGS", {"cone": "pyramidal", "solver": "PGS"}),
     ("mujoco", "implicitfast, elliptic, CG, tolerance 1e-6", {"tolerance": "1e-6"}),
     ("mujoco", "implicitfast, elliptic, CG, 20 iterations", {"iterations": "20"}),
+    ("mujoco", "implicitfast, elliptic, CG, 10 iterations", {"iterations": "10"}),
     ("mujoco", "implicitfast, elliptic, Newton (MuJoCo's default solver)", {"solver": "Newton"}),
     ("mujoco", "implicitfast, elliptic, CG, solref 0.01 s (stiffer)", {"timeconst": "0.01"}),
     ("pybullet", "rigid bodies, 50 iterations (the default here and PyBullet's)", {}),
+    ("pybullet", "rigid bodies, 20 iterations", {"solver_iterations": "20"}),
     ("pybullet", "rigid bodies, 10 iterations (Bullet's own default)", {"solver_iterations": "10"}),
     ("pybullet", "rigid bodies, 4 iterations", {"solver_iterations": "4"}),
     ("pybullet", "multibodies, 50 iterations (PyBullet's default body)", {"maximal_coordinates": "false"}),
@@ -38,8 +41,11 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds allowed per run")
     parser.add_argument("--only", choices=sorted({engine for engine, _, _ in TRIED}))
+    parser.add_argument("--numbers", help="comma-separated: run only these settings (1 is the first above)")
     args = parser.parse_args()
     tried = [t for t in TRIED if args.only in (None, t[0])]
+    if args.numbers:
+        tried = [TRIED[int(k) - 1] for k in args.numbers.split(",")]
     rates: dict[str, list[float]] = {label: [] for _, label, _ in tried}
     last = {}
     for r in range(1, args.rounds + 1):
