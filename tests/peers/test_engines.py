@@ -4,6 +4,7 @@
 A peer whose package is not installed (the optional ``bench`` extra) is skipped, by name."""
 
 import importlib.util
+import re
 
 import numpy as np
 import pytest
@@ -67,3 +68,22 @@ def test_pybullet_balls_are_rigid_bodies_in_the_peers_and_the_bench_pile():
     run = PybulletRun(Landing.of(8), PybulletSettings())
     assert {p.getDynamicsInfo(b, -1, physicsClientId=run.client)[10] for b in run.balls} == {1}
     p.disconnect(physicsClientId=run.client)
+
+
+def test_settings_are_overridden_by_name_with_their_own_types():
+    mujoco = ENGINES["mujoco"].configure({"iterations": "20", "solver": "PGS", "tolerance": "1e-6"})
+    assert (mujoco.iterations, mujoco.solver, mujoco.tolerance) == (20, "PGS", 1e-6)
+    assert ENGINES["pybullet"].configure({"maximal_coordinates": "false"}).maximal_coordinates is False
+
+
+@pytest.mark.parametrize(
+    ("engine", "overrides", "message"),
+    [
+        ("mujoco", {"iterations": "many"}, "mujoco setting iterations='many': expected a whole number"),
+        ("pybullet", {"maximal_coordinates": "yes"}, "expected true or false"),
+        ("ballpit", {"solver": "CG"}, "ballpit has no setting 'solver' (it has integrator, substeps)"),
+    ],
+)
+def test_a_bad_setting_is_refused_by_name(engine, overrides, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        ENGINES[engine].configure(overrides)

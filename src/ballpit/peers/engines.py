@@ -27,6 +27,9 @@ class Run(Protocol):
     def velocities(self) -> np.ndarray: ...
 
 
+KINDS = {bool: "true or false", int: "a whole number", float: "a number", str: "text"}
+
+
 @dataclass(frozen=True)
 class Engine:
     name: str  # as on the command line and in the CSV
@@ -57,9 +60,8 @@ class Engine:
                 else:
                     changes[key] = type(default)(text)
             except ValueError:
-                raise ValueError(
-                    f"{self.name} setting {key}={text!r}: expected a {type(default).__name__}"
-                ) from None
+                kind = KINDS.get(type(default), type(default).__name__)
+                raise ValueError(f"{self.name} setting {key}={text!r}: expected {kind}") from None
         return dataclasses.replace(self.settings(), **changes)
 
     def start(self, landing: Landing, settings: Any) -> Run:
