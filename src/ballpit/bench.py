@@ -196,13 +196,8 @@ def figure(results: list[Result]) -> object:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogFormatterSciNotation
 
-    class PlainLog(LogFormatterSciNotation):
-        """Labels where matplotlib's log axis puts them, written 1.75, 0.5 or 10,000, not 1.75×10⁰."""
-
-        def __call__(self, x: float, pos: int | None = None) -> str:
-            return f"{x:,.10g}" if super().__call__(x, pos) else ""
+    from .plots import label_log_axis_plainly
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for engine in sorted({r.engine for r in results}):
@@ -218,8 +213,7 @@ def figure(results: list[Result]) -> object:
                     label=f"{engine} {workload}",
                 )
     for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_formatter(PlainLog())
-        axis.set_minor_formatter(PlainLog(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
+        label_log_axis_plainly(axis)
     ax.set_xlabel("balls")
     ax.set_ylabel("ms per step")
     ax.grid(True, which="both", alpha=0.3)

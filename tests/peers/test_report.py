@@ -141,3 +141,22 @@ def test_each_engine_lands_the_small_grid_in_its_box_without_passing_through(sma
 def test_each_peer_names_its_fastest_stable_settings():
     assert ENGINES["mujoco"].settings().describe().startswith("implicitfast, elliptic cones, CG solver")
     assert ENGINES["pybullet"].settings().describe().startswith("rigid bodies (useMaximalCoordinates=True)")
+
+
+def test_the_plot_has_the_sizes_run_on_its_x_axes_and_plain_numbers_for_the_rates():
+    summaries = [
+        report.Summary(engine, n, [rate * 1000 / n], 0.2, 0.01, n, 0.25)
+        for engine, rate in (("ballpit", 40.0), ("mujoco", 30.0), ("pybullet", 20.0))
+        for n in (1000, 3000, 10000)
+    ]
+    fig = report.figure(summaries)
+    fig.canvas.draw()
+    rate, overlap = fig.axes
+    for ax in (rate, overlap):
+        assert [t.get_text() for t in ax.xaxis.get_majorticklabels()] == ["1,000", "3,000", "10,000"]
+    labels = [t.get_text() for t in rate.yaxis.get_majorticklabels() + rate.yaxis.get_minorticklabels()]
+    labels = [label for label in labels if label]
+    assert len(labels) >= 2
+    for label in labels:  # "2", "10", "40": no mathtext, no ×10ⁿ
+        assert float(label.replace(",", "")) > 0, label
+    assert [line.get_label() for line in overlap.get_lines()] == ["ballpit", "MuJoCo", "PyBullet"]

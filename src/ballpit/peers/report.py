@@ -137,6 +137,8 @@ def figure(summaries: list[Summary]) -> object:
     from matplotlib.figure import Figure
     from matplotlib.ticker import NullLocator
 
+    from ..plots import label_log_axis_plainly
+
     fig = Figure(figsize=(10.0, 4.2), dpi=120, layout="constrained")
     FigureCanvasAgg(fig)
     rate, overlap = fig.subplots(1, 2)
@@ -157,6 +159,7 @@ def figure(summaries: list[Summary]) -> object:
         ax.set_xticks(sizes, labels=[f"{n:,}" for n in sizes])
         ax.xaxis.set_minor_locator(NullLocator())
     rate.set_yscale("log")
+    label_log_axis_plainly(rate.yaxis)
     rate.set_xlabel("balls")
     rate.set_ylabel("steps of 1/240 s per second (median)")
     rate.set_title("the landing grid: step rate")
