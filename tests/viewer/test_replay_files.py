@@ -224,3 +224,105 @@ def test_csv_rows_that_never_end_stop_at_the_size_limit(monkeypatch):
         for line in lines:
             read += len(line)
     assert read <= 1 << 20
+
+
+def _trajectory_npz(path: Path, rows: int = 10, **columns: tuple[tuple, str, bytes]) -> Path:
+    """An .npz of the trajectory columns: ``rows`` zeros each (qw ones), except those given as
+    (shape, dtype descr, payload)."""
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            default = (
+                np.ones(rows) if column == "qw" else np.arange(rows) % 2 if column == "id" else np.zeros(rows)
+            )
+            shape, descr, payload = columns.get(column, ((rows,), "<f8", default.astype("<f8").tobytes()))
+            header = io.BytesIO()
+            np.lib.format.write_array_header_1_0(
+                header, {"descr": descr, "fortran_order": False, "shape": shape}
+            )
+            archive.writestr(f"{column}.npy", header.getvalue() + payload)
+    return path
+
+
+def test_a_column_of_the_wrong_length_is_refused_from_its_header_before_it_is_inflated(tmp_path, capsys):
+    # Its data is corrupt past the header (a wrong checksum): reading it whole would fail differently.
+    rows = 1 << 17
+    path = _trajectory_npz(tmp_path / "long.npz", x=((rows,), "<f8", bytes(rows * 8)))
+    blob = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as archive:
+        crc = archive.getinfo("x.npy").CRC.to_bytes(4, "little")
+    path.write_bytes(bytes(blob).replace(crc, bytes(4 * [0x5A])))
+    err = _replay_status(path, capsys)
+    assert "the trajectory columns have different lengths: 'x' has 131,072 rows, 'time' 10" in err
+
+
+@pytest.mark.slow
+def test_a_1_mb_replay_whose_column_inflates_to_1_gib_is_refused_within_100_mb(tmp_path):
+    # It was inflated first and then refused, at a peak of 1.08 GB.
+    path = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            rows = (1 << 30) // 8 if column == "x" else 10
+            header = io.BytesIO()
+            np.lib.format.write_array_header_1_0(
+                header, {"descr": "<f8", "fortran_order": False, "shape": (rows,)}
+            )
+            with archive.open(f"{column}.npy", "w", force_zip64=True) as member:
+                member.write(header.getvalue())
+                for _ in range(rows * 8 // (1 << 20)) if column == "x" else ():
+                    member.write(bytes(1 << 20))
+                member.write(bytes(rows * 8) if column != "x" else b"")
+    assert path.stat().st_size < 2e6
+    code = (
+        "import resource, sys\n"
+        "from ballpit import cli\n"
+        "status = cli.main(['view', 'slopes', '--replay', sys.argv[1]])\n"
+        "print(status, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=300)
+    status, peak_kib = map(int, r.stdout.split())
+    assert status == 2 and "'x' has 134,217,728 rows, 'time' 10" in r.stderr, r.stderr
+    assert peak_kib * 1024 < 100e6, f"{peak_kib / 1024:.0f} MiB"
+
+
+@pytest.mark.parametrize(
+    ("column", "dtype", "fragment"),
+    [
+        ("x", "<c16", "column 'x' holds complex numbers (complex128), not real numbers"),
+        ("y", "<U3", "column 'y' holds text (<U3), not real numbers"),
+        ("time", "|b1", "column 'time' holds true/false values (bool), not real numbers"),
+    ],
+)
+def test_a_column_that_does_not_hold_real_numbers_is_refused(tmp_path, capsys, column, dtype, fragment):
+    values = np.zeros(10, dtype=dtype) if dtype != "<U3" else np.array(["1"] * 10, dtype=dtype)
+    path = _trajectory_npz(tmp_path / "typed.npz", **{column: ((10,), dtype, values.tobytes())})
+    assert fragment in _replay_status(path, capsys)
+
+
+@pytest.mark.parametrize(
+    ("q", "fragment"),
+    [
+        ((0.0, 0.0, 0.0, 0.0), "orientation (0, 0, 0, 0) is not a unit quaternion (its length is 0"),
+        (
+            (0.0, 0.0, 0.0, 1.001),
+            "orientation (0, 0, 0, 1.001) is not a unit quaternion (its length is 1.001, not 1 within 1e-05)",
+        ),
+    ],
+)
+def test_an_orientation_that_is_not_a_unit_quaternion_is_refused(tmp_path, capsys, q, fragment):
+    rows = [_row(0.0, 0), _row(0.0, 1)]
+    rows[1][-4:] = q
+    path = _write_csv(tmp_path / "turned.csv", rows)
+    assert f"record 1, ball 1: {fragment}" in _replay_status(path, capsys)
+
+
+def test_an_npz_of_int_and_float32_columns_still_plays(tmp_path):
+    rows = 10
+    floats = {c: ((rows,), "<f4", np.zeros(rows, "<f4").tobytes()) for c in ("x", "y", "vx")}
+    path = _trajectory_npz(
+        tmp_path / "narrow.npz",
+        rows,
+        id=((rows,), "<i8", (np.arange(rows) % 5).astype("<i8").tobytes()),
+        **floats,
+    )
+    t = read_trajectory(path, n_balls=5)
+    assert (t.frames, t.balls) == (2, 5)

@@ -96,49 +96,82 @@ def _capped_lines(f: io.TextIOWrapper, limit: int) -> Iterator[str]:
         yield line
 
 
-def _check_npz_members(archive: zipfile.ZipFile) -> None:
-    """Refuse an archive before anything is inflated: more than MAX_BYTES of members, or an ``.npy``
-    member whose header claims more rows than its bytes hold (np.load would allocate them first)."""
+_REAL = "fiu"  # dtype kinds of real numbers: floats, signed and unsigned integers
+_KIND_NAMES = {"c": "complex numbers", "U": "text", "S": "bytes", "b": "true/false values", "O": "objects"}
+UNIT_TOLERANCE = 1e-5  # how far an orientation's length may be from 1 (9 digits in a CSV, float32 in an .npz)
+
+
+def _npy_headers(archive: zipfile.ZipFile) -> dict[str, tuple[tuple[int, ...], np.dtype]]:
+    """Every ``.npy`` member's shape and dtype, from its header alone. Refuses an archive before anything
+    is inflated: more than MAX_BYTES of members, or a member whose header claims more rows than its
+    bytes hold (np.load would allocate them first)."""
     members = archive.infolist()
     total = sum(m.file_size for m in members)
     if total > MAX_BYTES:
         raise InputRefused(
             f"its arrays hold {total} bytes, more than a trajectory may have ({size_text(MAX_BYTES)})"
         )
+    read_header = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+    headers = {}
     for m in members:
         if not m.filename.endswith(".npy"):
             continue
         with archive.open(m) as member:
             version = np.lib.format.read_magic(member)
-            read_header = {
-                (1, 0): np.lib.format.read_array_header_1_0,
-                (2, 0): np.lib.format.read_array_header_2_0,
-            }
             if version not in read_header:
                 raise InputRefused(f"array {m.filename!r} has an unknown .npy version {version}")
             shape, _, dtype = read_header[version](member)
-            claimed = math.prod(shape) * dtype.itemsize
-            if claimed > m.file_size:
-                raise InputRefused(f"array {m.filename!r} claims shape {shape} but holds {m.file_size} bytes")
+        if math.prod(shape) * dtype.itemsize > m.file_size:
+            raise InputRefused(f"array {m.filename!r} claims shape {shape} but holds {m.file_size} bytes")
+        headers[m.filename] = (shape, dtype)
+    return headers
+
+
+def _npz_sources(path: Path, headers: dict) -> dict[str, tuple[str, int | None]]:
+    """Where each trajectory column is in the archive: (member, None) for its own array, or (member, k)
+    for column k of a stacked (rows, k) one. Refuses, from the headers alone, a column that does not
+    hold real numbers or whose length differs from the others'."""
+    sources: dict[str, tuple[str, int | None]] = {}
+    for name in TRAJECTORY_COLUMNS:
+        if f"{name}.npy" in headers:
+            sources[name] = (f"{name}.npy", None)
+    for name, (width, column) in STACKED.items():  # stacked (rows, k) arrays → the CSV's columns
+        shape = headers.get(f"{name}.npy", ((),))[0]
+        if len(shape) == 2 and shape[1] == width:
+            start = TRAJECTORY_COLUMNS.index(column)
+            for k in range(width):
+                sources.setdefault(TRAJECTORY_COLUMNS[start + k], (f"{name}.npy", k))
+    rows = {}
+    for name, (member, k) in sources.items():
+        shape, dtype = headers[member]
+        if dtype.kind not in _REAL:
+            what = _KIND_NAMES.get(dtype.kind, f"values of type {dtype}")
+            raise TrajectoryError(f"{path}: column {name!r} holds {what} ({dtype}), not real numbers")
+        rows[name] = shape[0] if k is not None else math.prod(shape)
+    first = next(iter(rows), None)
+    odd = next((name for name, n in rows.items() if n != rows[first]), None)
+    if odd is not None:
+        raise TrajectoryError(
+            f"{path}: the trajectory columns have different lengths: {odd!r} has {rows[odd]:,} rows, "
+            f"{first!r} {rows[first]:,}"
+        )
+    return sources
 
 
 def _columns_from_npz(path: Path) -> dict[str, np.ndarray]:
+    """The trajectory columns of an ``.npz``: only the members that hold them are inflated, once their
+    headers have shown they fit together."""
     with open_regular(path, MAX_BYTES, "a trajectory") as f:
         if not zipfile.is_zipfile(f):
             raise TrajectoryError(f"{path}: not an .npz archive")
         f.seek(0)
         with zipfile.ZipFile(f) as archive:
-            _check_npz_members(archive)
-        f.seek(0)
-        with np.load(f, allow_pickle=False) as npz:
-            arrays = {name: np.asarray(npz[name]) for name in npz.files}
-    for name, (width, column) in STACKED.items():  # stacked (rows, k) arrays → the CSV's columns
-        if name in arrays and arrays[name].ndim == 2 and arrays[name].shape[1] == width:
-            stacked = arrays.pop(name)
-            start = TRAJECTORY_COLUMNS.index(column)
-            for k in range(width):
-                arrays.setdefault(TRAJECTORY_COLUMNS[start + k], stacked[:, k])
-    return arrays
+            sources = _npz_sources(path, _npy_headers(archive))
+            arrays: dict[str, np.ndarray] = {}
+            for member in dict.fromkeys(m for m, _ in sources.values()):
+                with archive.open(member) as data:
+                    arrays[member] = np.lib.format.read_array(data, allow_pickle=False)
+    return {name: arrays[m] if k is None else arrays[m][:, k] for name, (m, k) in sources.items()}
 
 
 def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
@@ -177,6 +210,7 @@ def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
         raise TrajectoryError(f"{path}: the trajectory holds values that are not finite numbers")
     times, ids = table[0], table[1]
     frame, counts = _records(path, ids)
+    _check_orientations(path, table[-4:], frame, ids)
     if n_balls is not None and counts[0] != n_balls:
         raise TrajectoryError(f"{path}: the trajectory has {counts[0]} balls but the scene has {n_balls}")
     n = int(counts.max())
@@ -203,6 +237,19 @@ def read_trajectory(path: Path | str, n_balls: int | None = None) -> Trajectory:
 
     return Trajectory(path, frame_times.copy(), frames_of(2, 3), frames_of(5, 3), frames_of(8, 3),
                       frames_of(11, 4), counts if counts.min() < n else None)  # fmt: skip
+
+
+def _check_orientations(path: Path, q: list[np.ndarray], frame: np.ndarray, ids: np.ndarray) -> None:
+    """Refuse an orientation that is not a unit quaternion (all zeros once played as NaN)."""
+    length = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    bad = np.flatnonzero(~(np.abs(length - 1.0) <= UNIT_TOLERANCE))
+    if len(bad):
+        r = int(bad[0])
+        shown = ", ".join(f"{c[r]:g}" for c in q)
+        raise TrajectoryError(
+            f"{path}: record {frame[r] + 1}, ball {ids[r]:g}: orientation ({shown}) is not a unit "
+            f"quaternion (its length is {length[r]:.6g}, not 1 within {UNIT_TOLERANCE:g})"
+        )
 
 
 def _records(path: Path, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
