@@ -37,10 +37,10 @@ def test_freed_arrays_stay_in_the_process_only_when_asked():
 
 
 def test_the_command_line_asks_for_it(monkeypatch):
-    from ballpit import cli
+    from ballpit import cli, commands
 
     asked = []
-    monkeypatch.setattr(cli, "keep_freed_memory", lambda: asked.append(True) or True)
+    monkeypatch.setattr(commands, "keep_freed_memory", lambda: asked.append(True) or True)
     with pytest.raises(SystemExit):
         cli.main(["--help"])
     assert asked

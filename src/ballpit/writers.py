@@ -74,16 +74,31 @@ def check_output_path(path: Path, what: str) -> str:
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"{path}: {what} must end in .csv or .npz, not {suffix or 'no suffix'!r}")
+    check_output_place(path, what)
+    return suffix
+
+
+def check_output_place(path: Path, what: str, folder: bool = False) -> None:
+    """OutputError unless ``path`` (a file, or with ``folder`` a folder of frames) can be made where it
+    is: names that fit, not a folder where a file goes, and the folder it goes into already there.
+    Every command that writes checks its outputs here, so none makes folders on the way (a mistyped
+    path once made one at the root of the file system)."""
     check_name_lengths(path, what)
     try:
-        if path.is_dir():
+        if path.is_dir() and not folder:
             raise OutputError(f"{path}: {what} is a directory")
-        parent = path.parent if str(path.parent) else Path(".")
+        if path.exists() and not path.is_dir() and folder:
+            raise OutputError(f"{path}: {what}: {str(path)!r} is a file, not a folder")
+        parent = _directory(path)
+        for above in (parent, *parent.parents):  # the nearest part that exists must be a folder
+            if above.exists():
+                if not above.is_dir():
+                    raise OutputError(f"{path}: {what}: {str(above)!r} is a file, not a folder")
+                break
         if not parent.is_dir():
             raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
     except OSError as e:
         raise OutputError(f"{shorten(path)}: {what}: {e.strerror or e}") from None
-    return suffix
 
 
 def temp_path(target: Path, pid: int | None = None) -> Path:
