@@ -14,8 +14,8 @@ import ballpit
 from ballpit.scene import read_scene
 from ballpit.viewer.replay import Replay, TrajectoryError, read_trajectory
 
-from ..test_cli import assert_user_error
-from ..test_cli import ballpit as run_ballpit
+from ..cli.test_commands import assert_user_error
+from ..cli.test_commands import ballpit as run_ballpit
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 

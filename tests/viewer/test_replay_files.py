@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 
 from ballpit import cli
+from ballpit.cli.writers import TRAJECTORY_COLUMNS
 from ballpit.scene import read_scene
 from ballpit.viewer import replay as replay_module
 from ballpit.viewer.recording import Recorder
 from ballpit.viewer.replay import Replay, read_trajectory
 from ballpit.viewer.simulation import Simulation
-from ballpit.writers import TRAJECTORY_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[2]
 SLOPES = ROOT / "scenes" / "slopes.toml"

@@ -12,7 +12,7 @@ import re
 import tomllib
 from pathlib import Path
 
-from ..inputs import InputRefused, open_regular, read_capped
+from ..cli.inputs import InputRefused, open_regular, read_capped
 
 SHOWN = 60  # characters: a value or key longer than this is shortened in messages, ending in …
 _NAMED = {"\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from ballpit.inputs import InputRefused, open_regular, size_text
-from ballpit.writers import TRAJECTORY_COLUMNS
+from ballpit.cli.inputs import InputRefused, open_regular, size_text
+from ballpit.cli.writers import TRAJECTORY_COLUMNS
 
 # stacked .npz arrays → (their width, the CSV column they start at)
 STACKED = {

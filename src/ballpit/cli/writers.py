@@ -22,8 +22,8 @@ from typing import IO
 
 import numpy as np
 
-from .physics import Contacts
-from .physics.contacts import KIND_NAMES
+from ..physics import Contacts
+from ..physics.contacts import KIND_NAMES
 
 TRAJECTORY_COLUMNS = ("time", "id", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "qx", "qy", "qz", "qw")
 EVENT_COLUMNS = ("time", "kind", "a", "b", "x", "y", "z", "nx", "ny", "nz", "impulse")

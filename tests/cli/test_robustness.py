@@ -17,9 +17,9 @@ import pytest
 
 import ballpit
 from ballpit import cli
-from ballpit.simulate import run
+from ballpit.cli.simulate import run
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_a_closed_stdout_ends_the_run_quietly():

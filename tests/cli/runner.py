@@ -18,7 +18,7 @@ import sys
 import traceback
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 class _Stream(io.TextIOWrapper):
@@ -37,7 +37,8 @@ class _Stream(io.TextIOWrapper):
 
 def run_in_process(*args: str | Path, cwd: Path = ROOT, **_: object) -> subprocess.CompletedProcess:
     """``ballpit ARGS`` in this process (extra keywords such as ``timeout`` are accepted and ignored)."""
-    from ballpit import cli, commands
+    from ballpit import cli
+    from ballpit.cli import commands
 
     argv = [str(a) for a in args]
     out, err = _Stream(), _Stream()

@@ -1,6 +1,6 @@
 """The command line: exit codes, one-line errors, output files and their columns.
 
-Run in this process (``cli_runner.py``) except where the process itself is under test: signals, file
+Run in this process (``runner.py``) except where the process itself is under test: signals, file
 size limits and the console script start a real ``python -m ballpit``.
 """
 
@@ -20,8 +20,8 @@ import pytest
 
 from ballpit.scene import load_scene
 
-from .cli_runner import ROOT
-from .cli_runner import run_in_process as ballpit
+from .runner import ROOT
+from .runner import run_in_process as ballpit
 
 TRAJECTORY_HEADER = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw"
 EVENTS_HEADER = "time,kind,a,b,x,y,z,nx,ny,nz,impulse"
@@ -441,7 +441,7 @@ def test_a_background_run_is_killed_when_its_test_fails_or_times_out():
 def test_a_background_run_dies_with_a_test_process_that_is_killed_outright(tmp_path):
     """As when a time limit kills pytest itself: no ``finally`` runs, and still nothing is left."""
     code = (
-        "import sys, time; sys.path.insert(0, sys.argv[1]); from tests.test_cli import start; "
+        "import sys, time; sys.path.insert(0, sys.argv[1]); from tests.cli.test_commands import start; "
         "p = start('simulate', 'scenes/pile10k.toml', '--duration', '60', '-q'); "
         "print(p.pid, flush=True); time.sleep(600)"
     )

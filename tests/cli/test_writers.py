@@ -11,14 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit import cli, writers
+from ballpit import cli
+from ballpit.cli import writers
+from ballpit.cli.simulate import step_plan
 from ballpit.physics import Contacts
 from ballpit.scene import read_scene
-from ballpit.simulate import step_plan
 
-from .cli_runner import run_in_process
+from .runner import run_in_process
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SLOPES = ROOT / "scenes" / "slopes.toml"
 TRAJECTORY = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw".split(",")
 EVENTS = "time,kind,a,b,x,y,z,nx,ny,nz,impulse".split(",")

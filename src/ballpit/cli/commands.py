@@ -16,16 +16,16 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from . import __version__
+from .. import __version__
+from . import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from .allocator import keep_freed_memory
 from .arguments import OneLineParser, one_line
 from .arguments import count as _count
 from .arguments import positive as _positive
 from .arguments import size as _size
-from .cli import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 
 if TYPE_CHECKING:
-    from .physics import World
+    from ..physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
 
@@ -46,7 +46,7 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    from .physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
+    from ..physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
 
     labels = [integrator.label for integrator in INTEGRATORS.values()]
     integrator_labels = ", ".join(labels[:-1]) + " and " + labels[-1]  # "Euler, RK2, RK4 and ..."
@@ -149,7 +149,7 @@ def run(argv: Sequence[str] | None) -> int:
         args_list = ["view", *args_list]
     parser = build_parser()
     args = parser.parse_args(args_list)
-    from .scene import SceneError
+    from ..scene import SceneError
     from .writers import OutputError, OutputFailed
 
     try:
@@ -167,7 +167,7 @@ def _looks_like_scene(arg: str) -> bool:
 
 
 def _load(scene_arg: str):
-    from .scene import read_scene, resolve_scene_path
+    from ..scene import read_scene, resolve_scene_path
 
     return read_scene(resolve_scene_path(scene_arg))
 
@@ -188,7 +188,7 @@ class StepTotals:
     on to another observer (the energy plot) if there is one."""
 
     def __init__(self, then: Callable[[World], None] | None) -> None:
-        from .physics.profile import RunProfile
+        from ..physics.profile import RunProfile
 
         self.totals = RunProfile()
         self.then = then
@@ -287,7 +287,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _view(args: argparse.Namespace) -> int:
-    from .scene import resolve_scene_path
+    from ..scene import resolve_scene_path
     from .writers import check_output_path
 
     if args.record is not None:
@@ -300,7 +300,7 @@ def _view(args: argparse.Namespace) -> int:
         world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
     trajectory = None
     if args.replay is not None:
-        from .viewer.replay import TrajectoryError, read_trajectory
+        from ..viewer.replay import TrajectoryError, read_trajectory
 
         world = world if world is not None else _load("slopes").world
         try:
@@ -309,7 +309,7 @@ def _view(args: argparse.Namespace) -> int:
             print(f"ballpit: {e}", file=sys.stderr)
             return EXIT_BAD_INPUT
     try:
-        from .viewer.app import run
+        from ..viewer.app import run
     except ImportError as e:
         print(
             f"ballpit: the viewer is not available ({e}); 'ballpit simulate' runs scenes headless",
@@ -320,7 +320,7 @@ def _view(args: argparse.Namespace) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from .scene import resolve_scene_path
+    from ..scene import resolve_scene_path
     from .writers import OutputError, OutputFailed, check_name_lengths, check_output_place
 
     path = resolve_scene_path(args.scene)
@@ -334,7 +334,7 @@ def _render(args: argparse.Namespace) -> int:
         )
     check_output_place(out, "--out", folder)
     try:
-        from .viewer.render import frame_count, render
+        from ..viewer.render import frame_count, render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
@@ -410,7 +410,7 @@ def _bench(argv: list[str]) -> int:
 
 
 def _scenes(args: argparse.Namespace) -> int:
-    from .scene import bundled_scenes
+    from ..scene import bundled_scenes
 
     for path in bundled_scenes():
         first = next(

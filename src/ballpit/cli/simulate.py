@@ -14,9 +14,9 @@ from dataclasses import dataclass, fields
 import numpy as np
 from tqdm import tqdm
 
-from .physics import DEFAULT_TIMESTEP, Contacts, World
-from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
-from .physics.validation import MAX_TIMESTEP
+from ..physics import DEFAULT_TIMESTEP, Contacts, World
+from ..physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
+from ..physics.validation import MAX_TIMESTEP
 from .writers import EventWriter, TrajectoryWriter
 
 
