@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit.cli.writers import TRAJECTORY_COLUMNS
+from ballpit.cli.trajectory import TRAJECTORY_COLUMNS
 from ballpit.scene import default_scene_path, read_scene
 
 from .conftest import subprocess_env
@@ -180,7 +180,7 @@ def test_the_close_button_writes_the_record_and_a_reset_starts_the_timeline_agai
     live = read_scene(tmp_path / "live.toml")
     world = live.world
     from ballpit.cli.simulate import run
-    from ballpit.cli.writers import TrajectoryWriter
+    from ballpit.cli.trajectory import TrajectoryWriter
 
     writer = TrajectoryWriter(tmp_path / "sim.npz", len(world.spheres))
     run(world, r["steps_since_reset"] * live.timestep, dt=live.timestep, trajectory=writer)

@@ -204,7 +204,8 @@ class StepTotals:
 
 def _simulate(args: argparse.Namespace) -> int:
     from .simulate import MAX_STEPS, format_summary, run, step_count, step_longer_than_run
-    from .writers import EventWriter, OutputError, TrajectoryWriter
+    from .trajectory import TrajectoryWriter
+    from .writers import EventWriter, OutputError
 
     info = _load(args.scene)
     world = info.world
@@ -300,7 +301,7 @@ def _view(args: argparse.Namespace) -> int:
         world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
     trajectory = None
     if args.replay is not None:
-        from ..viewer.replay import TrajectoryError, read_trajectory
+        from .trajectory import TrajectoryError, read_trajectory
 
         world = world if world is not None else _load("slopes").world
         try:

@@ -17,7 +17,8 @@ from tqdm import tqdm
 from ..physics import DEFAULT_TIMESTEP, Contacts, World
 from ..physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from ..physics.validation import MAX_TIMESTEP
-from .writers import EventWriter, TrajectoryWriter
+from .trajectory import TrajectoryWriter
+from .writers import EventWriter
 
 
 @dataclass(frozen=True)
