@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from ballpit import cli
+from ballpit.cli import trajectory as trajectory_module
 from ballpit.cli import writers
 from ballpit.cli.simulate import step_plan
 from ballpit.physics import Contacts
@@ -146,7 +147,8 @@ def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
 @pytest.mark.slow
 def test_many_small_chunks_give_the_same_files(tmp_path, monkeypatch, slopes_reference):
     """Chunks of 7 rows: trajectory records and step contacts are split across many chunks."""
-    monkeypatch.setattr(writers, "_CHUNK_ROWS", 7)
+    monkeypatch.setattr(writers, "CHUNK_ROWS", 7)
+    monkeypatch.setattr(trajectory_module, "CHUNK_ROWS", 7)
     trajectory, events, _ = slopes_reference
     for suffix in ("csv", "npz"):
         out, ev = tmp_path / f"t.{suffix}", tmp_path / f"e.{suffix}"
