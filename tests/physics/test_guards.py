@@ -192,9 +192,23 @@ def test_a_ball_view_kept_from_before_a_restore_says_the_ball_is_no_longer_there
     plane = world.add_plane(position=(0, 10, 0))
     world.restore(snap)
     for read in (lambda: later.position, lambda: later.radius, lambda: setattr(later, "velocity", (1, 0, 0))):
-        gone = r"^sphere #2 is no longer in the world, which holds 2 balls: it was restored to a snapshot"
-        with pytest.raises(IndexError, match=gone + r" taken before this ball was added$"):
+        gone = r"^sphere #2 is no longer in the world, which holds 2 balls: it was removed, or the world"
+        with pytest.raises(
+            IndexError, match=gone + r" restored to a snapshot taken before this ball was added$"
+        ):
             read()
     with pytest.raises(IndexError, match=r"^plane #1 is no longer in the world, which holds 1 plane: "):
         _ = plane.normal
     assert world.spheres[1].position[1] > 2.0  # views of balls that were there still work
+
+
+def test_a_bad_value_is_not_put_back_from_another_balls_copy_after_a_ball_is_removed():
+    world = _world_with_balls()
+    world.add_sphere(position=(4, 1, 0))
+    assert world.spheres.positions[2, 0] == 4.0  # copied now, as the views hand the positions out
+    world.remove_sphere(0)  # the rows after it move down: the copy no longer lines up
+    world.spheres[1].position[:] = math.nan
+    with pytest.raises(ValueError, match=r"^sphere #1 has a non-finite position"):
+        world.step(0.01)
+    assert world.spheres[0].position[0] == 2.0  # nothing of the removed ball's written anywhere
+    assert world.spheres[1].position.tolist() == [4.0, 1.0, 0.0]  # put back from a copy taken since

@@ -109,14 +109,14 @@ class _Body:
 
     @property
     def row(self) -> int:
-        """``index``, once it is checked that the world still has this body: a world restored to a
-        snapshot taken before the body was added has not (IndexError, saying so)."""
+        """``index``, once it is checked that the world still has this body: one removed, or a world
+        restored to a snapshot taken before the body was added, has not (IndexError, saying so)."""
         n = self._count()
         if self.index >= n:
             noun = self._noun if n == 1 else f"{self._noun}s"
             raise IndexError(
                 f"{self._kind} #{self.index} is no longer in the world, which holds {n} {noun}: it was "
-                f"restored to a snapshot taken before this {self._noun} was added"
+                f"removed, or the world restored to a snapshot taken before this {self._noun} was added"
             )
         return self.index
 
