@@ -2,7 +2,7 @@
 
 Each setting lands the grid in its own process, the settings taking turns over the rounds (as in
 ``ballpit bench --peers``); "stable" is every ball still in the box and the deepest overlap well under
-a radius. The defaults in ``ballpit/peers/mujoco_engine.py`` and ``pybullet_engine.py`` are the
+a radius. The defaults in ``ballpit/cli/peers/mujoco_engine.py`` and ``pybullet_engine.py`` are the
 fastest stable ones found here (docs/benchmarks.md has the figures).
 
     .venv/bin/python benchmarks/peer_settings.py [--balls 1000] [--steps 480] [--rounds 2] [--only mujoco]
@@ -12,12 +12,12 @@ fastest stable ones found here (docs/benchmarks.md has the figures).
 import argparse
 import statistics
 
-from ballpit.peers.engines import ENGINES
-from ballpit.peers.rounds import land_isolated
+from ballpit.cli.peers.engines import ENGINES
+from ballpit.cli.peers.rounds import land_isolated
 
 # MuJoCo's settings are varied from implicitfast, elliptic cones, CG, 100 iterations (MuJoCo's own
 # iteration count), PyBullet's from rigid bodies at 50 iterations (PyBullet's own); the defaults in
-# ballpit/peers are entries 8 and 12.
+# ballpit/cli/peers are entries 8 and 12.
 M100 = {"iterations": "100"}
 TRIED = [
     ("mujoco", "implicitfast, elliptic, CG, 100 iterations", M100),

@@ -7,11 +7,11 @@ import statistics
 
 import pytest
 
-from ballpit import bench
-from ballpit.peers import report
-from ballpit.peers.engines import ENGINES
-from ballpit.peers.landing import RESTITUTION
-from ballpit.peers.measure import Landed
+from ballpit.cli import bench
+from ballpit.cli.peers import report
+from ballpit.cli.peers.engines import ENGINES
+from ballpit.cli.peers.landing import RESTITUTION
+from ballpit.cli.peers.measure import Landed
 
 from .test_engines import ALL, BOUNCE_TOLERANCE
 

@@ -9,9 +9,9 @@ import re
 import numpy as np
 import pytest
 
-from ballpit.peers.engines import ENGINES
-from ballpit.peers.landing import DT, FRICTION, GRAVITY, RADIUS, RESTITUTION, Landing
-from ballpit.peers.measure import bounce
+from ballpit.cli.peers.engines import ENGINES
+from ballpit.cli.peers.landing import DT, FRICTION, GRAVITY, RADIUS, RESTITUTION, Landing
+from ballpit.cli.peers.measure import bounce
 
 # MuJoCo's contact is a damped spring; at 240 Hz it bounces livelier on fast impacts (mujoco_engine.py)
 BOUNCE_TOLERANCE = {"ballpit": 0.01, "mujoco": 0.1, "pybullet": 0.03}
@@ -56,7 +56,7 @@ def test_pybullet_balls_are_rigid_bodies_in_the_peers_and_the_bench_pile():
     pytest.importorskip("pybullet", reason="pybullet is not installed (pip install 'ballpit[bench]')")
     import pybullet as p
 
-    from ballpit.peers.pybullet_engine import PybulletRun, PybulletSettings, build_world
+    from ballpit.cli.peers.pybullet_engine import PybulletRun, PybulletSettings, build_world
 
     client = p.connect(p.DIRECT)
     try:

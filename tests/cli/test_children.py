@@ -2,7 +2,7 @@
 
 import pytest
 
-from ballpit.children import run_child
+from ballpit.cli.children import run_child
 
 CHILDREN = {
     "answers": 'print("warming up")\nprint(\'{"steps": 3, "seconds": 0.5}\')\n',

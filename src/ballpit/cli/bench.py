@@ -1,7 +1,7 @@
 """Step-rate benchmarks: free flight, a falling grid of balls piling into a box, a pile at rest, and
 the slopes and see-saw demos.
 
-Every measurement runs in its own process (``python -m ballpit.bench --one ...``) so engines and sizes
+Every measurement runs in its own process (``python -m ballpit.cli.bench --one ...``) so engines and sizes
 do not share caches or memory, and so the peak resident memory per ball can be read honestly.
 PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile for comparison.
 
@@ -93,7 +93,7 @@ def _ballpit_world(workload: str, n: int):
     import ballpit
 
     if workload in DEMOS:  # the bundled demo as it is (its own ball count; ``n`` is not used)
-        from .scene import read_scene, resolve_scene_path
+        from ..scene import read_scene, resolve_scene_path
 
         return read_scene(resolve_scene_path(workload)).world
     world = ballpit.World(integrator="rk4")
@@ -160,7 +160,7 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
 def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float) -> Result | None:
     """``measure_one`` in a fresh interpreter (``children.py``); None (after one line on stderr) when
     it fails."""
-    result = run_child("ballpit.bench", ["--one", engine, workload, str(n), str(steps)], timeout)
+    result = run_child("ballpit.cli.bench", ["--one", engine, workload, str(n), str(steps)], timeout)
     if isinstance(result, dict):
         try:
             return Result(**result)

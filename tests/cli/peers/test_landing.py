@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ballpit.peers.landing import (
+from ballpit.cli.peers.landing import (
     RADIUS,
     Landing,
     inside_box,

@@ -1,4 +1,4 @@
-"""``python -m ballpit.peers ENGINE N STEPS [KEY=VALUE ...]``: one landing, its result as JSON."""
+"""``python -m ballpit.cli.peers ENGINE N STEPS [KEY=VALUE ...]``: one landing, its result as JSON."""
 
 import sys
 

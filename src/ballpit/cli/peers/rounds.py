@@ -1,6 +1,6 @@
 """Each landing in a fresh interpreter, the engines taking turns round after round (A B C A B C ...).
 
-A child runs ``python -P -m ballpit.peers ENGINE N STEPS [KEY=VALUE ...]`` and prints its ``Landed``
+A child runs ``python -P -m ballpit.cli.peers ENGINE N STEPS [KEY=VALUE ...]`` and prints its ``Landed``
 as one line of JSON. Taking turns spreads a busy machine's slow spells over every engine, and a fresh
 process gives none of them another's caches or heap.
 """
@@ -32,7 +32,7 @@ def land_isolated(
 ) -> Landed | str:
     """``land`` in a fresh interpreter (``children.py``): its ``Landed``, or one line saying why it failed."""
     pairs = [f"{k}={v}" for k, v in (overrides or {}).items()]
-    result = run_child("ballpit.peers", [engine, str(n), str(steps), *pairs], timeout)
+    result = run_child("ballpit.cli.peers", [engine, str(n), str(steps), *pairs], timeout)
     if isinstance(result, str):
         return result
     try:
