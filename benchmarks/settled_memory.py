@@ -16,8 +16,8 @@ import linecache
 import sys
 import tracemalloc
 
-from ballpit import bench
-from ballpit.allocator import keep_freed_memory
+from ballpit.cli import bench
+from ballpit.cli.allocator import keep_freed_memory
 
 FRAME = bench.SUBSTEPS * bench.DT
 

@@ -68,14 +68,17 @@ def test_a_step_undone_for_leaving_the_steppable_range_puts_a_moving_plane_back_
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the overflow the step is undone for
-def test_a_step_made_non_finite_puts_a_moving_plane_back_where_it_began():
-    # falling for 1e200 s under gravity overflows to inf: the step is undone, the plane's move too
+def test_a_step_made_non_finite_puts_a_turning_plane_back_where_it_began():
+    # a drag of 1e300 /s on a ball flying at 1 m/s overflows its deceleration to inf: the step is undone,
+    # and so is the turn of the plane
     world = rising_floor_world()
     world.planes[0].velocity = (0, 0, 0)
     world.planes[0].angular_velocity = (0, 0, 0.1)
+    world.add_sphere(position=(10, 1, 0), radius=0.1, velocity=(1, 0, 0))
+    world.linear_drag = 1e300
     orientation = world.planes[0].orientation.copy()
     with pytest.raises(FloatingPointError, match="undone"):
-        world.step(1e200)
+        world.step(1 / 240)
     assert np.array_equal(world.planes[0].orientation, orientation)
 
 

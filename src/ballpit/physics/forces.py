@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .state import V, W
+from .state import Q, V, W, X
 
 
 class ForceTerm(Protocol):
@@ -109,3 +109,24 @@ def constant_acceleration(forces: Sequence[ForceTerm]) -> tuple[np.ndarray, np.n
             return None
         lin, ang = constant(lin, ang)
     return lin, ang
+
+
+def column_accelerations(
+    terms: Sequence[ForceTerm],
+    constant: tuple[np.ndarray, np.ndarray] | None,
+    x: np.ndarray,
+    vw: np.ndarray,
+    q: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Linear and angular accelerations (3, M) of M balls laid out as columns (positions ``x`` (3, M),
+    velocities and spins ``vw`` (6, M), orientations ``q`` (M, 4)) under the force terms, at this state;
+    ``constant`` is ``constant_acceleration(terms)``, made once."""
+    if constant is not None:
+        lin, ang = constant
+        return lin.T, ang.T
+    state = np.empty((x.shape[1], 13))
+    state[:, X], state[:, V], state[:, Q], state[:, W] = x.T, vw[:3].T, q, vw[3:].T
+    lin, ang = np.zeros((len(state), 3)), np.zeros((len(state), 3))
+    for term in terms:
+        term.add(state, lin, ang)
+    return lin.T, ang.T

@@ -98,6 +98,15 @@ class Model:
         cols.full("rolling_friction")[rows] = rolling_friction
         return rows
 
+    def append_plane(self, half_size: tuple[float, float], properties: dict[str, object]) -> int:
+        """Room for one more plane with these (validated) half extents, materials and motion; its row."""
+        cols = self.planes
+        i = cols.reserve(1).start
+        cols.full("half_size")[i] = half_size
+        for key, value in properties.items():
+            cols.full(key)[i] = value
+        return i
+
     def moving_planes(self) -> bool:
         """True when some plane has a velocity or turns (``plane_spin``)."""
         return bool(self.planes.velocity.any() or self.plane_spin().any())

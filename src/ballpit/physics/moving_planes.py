@@ -18,6 +18,13 @@ from .model import Model
 from .state import Columns, State
 
 
+def place(pose: Columns, i: int, center: np.ndarray, q: np.ndarray) -> None:
+    """The pose of plane ``i``, just added: its centre and its orientation ``q`` (with the axes it gives)."""
+    pose.reserve(1)
+    pose.full("center")[i] = center
+    set_orientation(pose, i, q)
+
+
 def set_orientation(pose: Columns, i: int, q: np.ndarray) -> None:
     """Store orientation ``q`` of plane ``i`` with the axes it gives: x (width), y (normal) and z."""
     _store_orientation(pose, i, tuple(np.asarray(q, float).tolist()))

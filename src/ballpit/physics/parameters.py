@@ -53,12 +53,14 @@ class Number(Parameter):
 
 
 class Count(Parameter):
-    """A whole number of at least 1."""
+    """A whole number of at least 1 (and at most ``most``)."""
+
+    def __init__(self, doc: str, most: int | None = None) -> None:
+        super().__init__(doc)
+        self.most = most
 
     def checked(self, value: object) -> int:
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise ValueError(f"{self.name} must be a whole number of at least 1, got {value!r}")
-        return int(value)
+        return validation.whole_number(self.name, value, 1, self.most)
 
 
 class Flag(Parameter):

@@ -48,7 +48,7 @@ import numpy as np
 from . import impacts, jacobi, quaternion, separate
 from .contact_model import Impulses, dot, softness
 from .contacts import ContactPoints
-from .forces import ForceTerm, constant_acceleration, forces_of
+from .forces import ForceTerm, column_accelerations, constant_acceleration, forces_of
 from .model import Model
 from .profile import Stage, StepProfile
 from .resting import WarmStart
@@ -203,7 +203,7 @@ class SoftFrame:
 def integrate_velocities(f: SoftFrame) -> None:
     """v += a·h, ω += α·h under the force terms (gravity, drag)."""
     live = f.live
-    lin, ang = _accelerations(f.terms, f.constant, f.x[:, live], f.vw[:, live], f.q)
+    lin, ang = column_accelerations(f.terms, f.constant, f.x[:, live], f.vw[:, live], f.q)
     f.vw[:3, live] += lin * f.h
     f.vw[3:, live] += ang * f.h
 
@@ -302,19 +302,6 @@ def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, ad
     # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now
     f.whole = f.k.whole
     f.k = f.vw = f.q = f.tangential = f.came_with = f.vn_start = None
-
-
-def _accelerations(terms, constant, x: np.ndarray, vw: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Linear and angular accelerations (3, M) of the balls under the force terms, at this state."""
-    if constant is not None:
-        lin, ang = constant
-        return lin.T, ang.T
-    state = np.empty((x.shape[1], 13))
-    state[:, X], state[:, V], state[:, Q], state[:, W] = x.T, vw[:3].T, q, vw[3:].T
-    lin, ang = np.zeros((len(state), 3)), np.zeros((len(state), 3))
-    for term in terms:
-        term.add(state, lin, ang)
-    return lin.T, ang.T
 
 
 def _normal_speed(k: jacobi.ContactColumns, vw: np.ndarray) -> np.ndarray:

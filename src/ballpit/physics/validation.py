@@ -25,6 +25,18 @@ MAX_GRAVITY = 1e9
 # A Python int too large for a float (10**400) is named so, not shown: its repr may be thousands of digits.
 TOO_LARGE = "an integer too large for a float"
 UNIT_TOLERANCE = 1e-6  # how far a plane's normal, axes or orientation may be from unit length
+# The longest step (s): the same bound as every other number. Positions, speeds and accelerations within
+# theirs then stay far from overflow through a step's squares and products (a step of 1e100 s overflowed
+# a·h² and printed warnings before the step was undone); a step this long is a mistake, not a run.
+MAX_TIMESTEP = 1e9
+# Soft substeps per crowded step: as many as a split step may have intervals (settings.MAX_INTERVALS). A
+# frame tried again takes up to four times as many; a step divided finer than this is a smaller
+# timestep's job, and 10⁹ substeps (which a scene once asked for) would take days a step.
+MAX_SUBSTEPS = 1_000
+# A coefficient of restitution, a ball's or a plane's: from 0 (dead) to 1 (elastic). More would be a ball
+# that leaves faster than it came, and the step keeps no impact from adding energy (impacts.py): it would
+# be held to 1 without a word, so it is refused instead.
+RESTITUTION_RANGE = (0.0, 1.0)
 
 
 def vector(name: str, value: object, length: int = 3, limit: float = math.inf) -> np.ndarray:
@@ -71,6 +83,27 @@ def number(
         raise ValueError(f"{name} must not be negative, got {value!r}")
     if within is not None and not within[0] <= x <= within[1]:
         raise ValueError(f"{name} must be from {within[0]:g} to {within[1]:g}, got {value!r}")
+    return x
+
+
+def whole_number(name: str, value: object, low: int, high: int | None = None) -> int:
+    """An int (a NumPy integer too, never a bool) from ``low`` to ``high``, or ValueError naming ``name``."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | np.integer)
+        or value < low
+        or (high is not None and value > high)
+    ):
+        bound = f"of at least {low}" if high is None else f"from {low} to {high:,}"
+        raise ValueError(f"{name} must be a whole number {bound}, got {value!r}")
+    return int(value)
+
+
+def timestep(dt: object) -> float:
+    """A step's length (s): positive and at most ``MAX_TIMESTEP``."""
+    x = number("dt", dt, positive=True)
+    if x > MAX_TIMESTEP:
+        raise ValueError(f"dt must be at most {MAX_TIMESTEP:g} s, got {dt!r}")
     return x
 
 
@@ -176,7 +209,7 @@ def ball(
         orientation=quaternion("orientation", orientation),
         radius=number("radius", radius, within=RADIUS_RANGE),
         mass=number("mass", mass, within=MASS_RANGE),
-        restitution=number("restitution", restitution, nonnegative=True),
+        restitution=number("restitution", restitution, within=RESTITUTION_RANGE),
         friction=number("friction", friction, nonnegative=True),
         rolling_friction=number("rolling_friction", rolling_friction, nonnegative=True),
         hollow=bool(hollow),
@@ -207,7 +240,7 @@ def balls(
         orientation=array_of("orientation", orientation, n, 4),
         radius=array_of("radius", radius, n, None, RADIUS_RANGE),
         mass=array_of("mass", mass, n, None, MASS_RANGE),
-        restitution=array_of("restitution", restitution, n, None, (0.0, math.inf)),
+        restitution=array_of("restitution", restitution, n, None, RESTITUTION_RANGE),
         friction=array_of("friction", friction, n, None, (0.0, math.inf)),
         rolling_friction=array_of("rolling_friction", rolling_friction, n, None, (0.0, math.inf)),
     )
@@ -242,7 +275,7 @@ def plane(
         q = rotations.IDENTITY.copy()
     extent = (math.inf, math.inf) if size is None else plane_size("size", size)
     materials = {
-        "restitution": number("restitution", restitution, nonnegative=True),
+        "restitution": number("restitution", restitution, within=RESTITUTION_RANGE),
         "friction": number("friction", friction, nonnegative=True),
         "rolling_friction": number("rolling_friction", rolling_friction, nonnegative=True),
     }

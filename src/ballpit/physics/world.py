@@ -62,7 +62,8 @@ class World:
         self.crowded_steps = 0  # how many steps were taken as soft substeps (crowded)
         self.profile = StepProfile()  # the last step's time per stage (profile.py)
         self._workspace = Workspace()
-        self._good_planes: np.ndarray | None = None  # the plane columns after the last step (validation.py)
+        self._good_planes: steppable.PlanesAsStepped | None = None  # the plane columns after the last step
+        self._good_balls = steppable.LastGoodBalls()  # the ball states, once views hand them out
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -92,7 +93,8 @@ class World:
     solver_iterations = Count("Projected Gauss–Seidel sweeps per contact solve (at least 1).")
     substeps = Count(
         "Soft substeps per crowded step (Box2D v3's soft step, softstep.py): a crowded step's contacts "
-        "are solved this many times, each over dt / substeps. The split-at-impacts path ignores it."
+        "are solved this many times, each over dt / substeps. The split-at-impacts path ignores it.",
+        most=validation.MAX_SUBSTEPS,
     )
     crowd_limit = Number(
         "A step in which more pairs than this may meet is taken whole, with speculative contacts "
@@ -199,6 +201,7 @@ class World:
         body[:, V] = velocity
         body[:, Q] = orientation
         body[:, W] = angular_velocity
+        self._good_balls.grow(self.state.body)
         return rows.start
 
     def add_plane(
@@ -232,16 +235,12 @@ class World:
             velocity,
             angular_velocity,
         )
-        shape = self.model.planes
-        i = shape.reserve(1).start
-        shape.full("half_size")[i] = (0.5 * width, 0.5 * depth)
-        for key, value in {**mat, **motion}.items():
-            shape.full(key)[i] = value
-        pose = self.state.planes
-        pose.reserve(1)
-        pose.full("center")[i] = center
-        moving_planes.set_orientation(pose, i, q)
-        self._remember_planes()
+        i = self.model.append_plane((0.5 * width, 0.5 * depth), {**mat, **motion})
+        moving_planes.place(self.state.planes, i, center, q)
+        if self._good_planes is None:
+            self._remember_planes()
+        else:
+            self._good_planes.add(self.model.planes, self.state.planes)
         return Plane(self, i)
 
     # ------------------------------------------------------------------ edits between steps (edits.py)
@@ -249,16 +248,19 @@ class World:
         """Give ball ``index`` a new ``radius`` and/or ``mass``; its inverse mass and inertia follow
         (2/5·m·r² solid, 2/3·m·r² hollow). Both are checked before either is written."""
         edits.set_sphere_size(self.model, self.parts, index, radius, mass)
+        self._good_balls.forget()
 
     def remove_sphere(self, index: int) -> None:
         """Remove ball ``index``; the balls after it move down one index."""
         edits.remove_sphere(self.model, self.parts, index)
+        self._good_balls.forget()  # a removed ball moves the rows after it
 
     def move_plane(self, index: int, position: object = None, rotation: object = None) -> None:
         """Put plane ``index``'s centre at ``position`` and/or turn it to ``rotation`` (extrinsic x, y, z
         degrees from the +y plane, as ``add_plane``). Both are checked before either is written."""
         edits.move_plane(self.model, self.parts, index, position, rotation)
         self._remember_planes()
+        self._good_balls.forget()
 
     def first_overlap(self, position: object, radius: float) -> str | None:
         """What a ball of ``radius`` at ``position`` would overlap ("ball 3", "plane 0"), or None: the
@@ -284,7 +286,9 @@ class World:
         still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
         the step's time per stage.
         """
-        step = pipeline.prepare(self.model, self.parts, self._workspace, dt, self._good_planes)
+        step = pipeline.prepare(
+            self.model, self.parts, self._workspace, dt, self._good_planes, self._good_balls
+        )
         awake = pipeline.wake(step)
         plan = pipeline.plan(step, awake.collision, awake.motion)
         checkpoint = Checkpoint.of(self.parts)  # the one undo: a soft frame's retry, a non-finite step
@@ -316,7 +320,7 @@ class World:
         """Put the world back as it was at ``snap``; stepping on repeats the original run bit for bit.
 
         The snapshot stays usable: it can be restored again. Live views of balls that did not exist
-        then raise IndexError when read.
+        then raise IndexError, saying so, when used.
         """
         if not isinstance(snap, Snapshot):
             raise TypeError(f"restore takes a Snapshot from World.snapshot(), got {type(snap).__name__}")
@@ -324,6 +328,7 @@ class World:
         checkpoint.restore(self.parts)
         self.crowded_steps = snap.crowded_steps
         self._remember_planes()
+        self._good_balls = steppable.LastGoodBalls()
 
     def copy(self) -> World:
         """An independent World in the same state (it steps on exactly as this one would)."""

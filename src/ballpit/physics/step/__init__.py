@@ -21,8 +21,6 @@ from __future__ import annotations
 
 from time import perf_counter
 
-import numpy as np
-
 from .. import steppable, validation
 from ..checkpoint import Checkpoint, Parts
 from ..contacts import ContactRecord, EventLog
@@ -39,14 +37,19 @@ __all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "se
 
 
 def prepare(
-    model: Model, parts: Parts, workspace: Workspace, dt: float, good_planes: np.ndarray | None
+    model: Model,
+    parts: Parts,
+    workspace: Workspace,
+    dt: float,
+    good_planes: steppable.PlanesAsStepped | None,
+    good_balls: steppable.LastGoodBalls | None = None,
 ) -> Step:
     """The step's context, once it is sure the engine can step the world: ValueError naming what it
     cannot (a bad plane value is put back to ``good_planes``, the columns as the last step left them)."""
-    dt = validation.number("dt", dt, positive=True)
+    dt = validation.timestep(dt)
     began = perf_counter()
     state = parts.state
-    steppable.reject_unsteppable_state(state.body)
+    steppable.reject_unsteppable_state(state.body, good_balls)
     planes = steppable.reject_bad_planes(model.planes, state.planes, good_planes)
     threshold, touching = model.restitution_threshold_for(dt), model.contact_slop()
     return Step(model, parts, workspace, dt, threshold, touching, EventLog(), StepProfile(), began, planes)

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from .. import moving_planes
 from ..checkpoint import Parts
 from ..contacts import EventLog
@@ -16,6 +14,7 @@ from ..pairs import PairCache
 from ..profile import Stage, StepProfile
 from ..resting import WarmStart
 from ..state import State
+from ..steppable import PlanesAsStepped
 
 
 @dataclass
@@ -37,7 +36,7 @@ class Step:
     events: EventLog
     profile: StepProfile
     began: float  # perf_counter() when the step began
-    checked_planes: np.ndarray  # the plane columns as the step found them (steppable.reject_bad_planes)
+    checked_planes: PlanesAsStepped  # the plane columns as the step found them (steppable.reject_bad_planes)
     intervals: int = 0
 
     # the parts, each by its name (read often)
