@@ -49,11 +49,11 @@ def test_dot_and_norm_sum_from_first_to_last():
     # 1 + 2⁻⁵³ rounds to 1 and so does the next + 2⁻⁵³: summed first to last the tiny terms vanish,
     # and summed the other way round they would not.
     a = np.array([1.0, 2.0**-53, 2.0**-53])
-    assert exact.dot(a, np.ones(3)) == 1.0
-    assert exact.dot(a[::-1], np.ones(3)) == 1.0 + 2.0**-52
+    assert exact.dot_rows(a, np.ones(3)) == 1.0
+    assert exact.dot_rows(a[::-1], np.ones(3)) == 1.0 + 2.0**-52
     rows = np.random.default_rng(1).normal(size=(1000, 3))
-    assert np.array_equal(exact.norm(rows), np.linalg.norm(rows, axis=1))  # NumPy's order over rows
-    assert exact.norm(np.array([3.0, 4.0, 12.0])) == 13.0
+    assert np.array_equal(exact.norm_rows(rows), np.linalg.norm(rows, axis=1))  # NumPy's order over rows
+    assert exact.norm_rows(np.array([3.0, 4.0, 12.0])) == 13.0
 
 
 def test_total_adds_from_first_to_last():
@@ -67,6 +67,25 @@ def test_cross_gives_the_bits_of_numpy_cross_for_every_broadcast():
     for shape_p, shape_q in [((500, 3), (500, 3)), ((3,), (3, 3)), ((500, 3), (3,)), ((4, 1, 3), (1, 6, 3))]:
         p = rng.standard_normal(shape_p) * rng.choice([0.0, -0.0, 1.0, 1e-300, 1e300], size=shape_p)
         q = rng.standard_normal(shape_q) * rng.choice([0.0, -0.0, 1.0, 3.0], size=shape_q)
-        got = exact.cross(p, q)
+        got = exact.cross_rows(p, q)
         assert got.shape == np.cross(p, q).shape
         assert got.tobytes() == np.cross(p, q).tobytes()
+
+
+def test_the_column_layout_gives_the_bits_of_the_row_layout():
+    # (3, K) columns and (K, 3) rows of the same vectors: the same sums in the same order
+    rng = np.random.default_rng(5)
+    a, b = rng.standard_normal((200, 3)) * 1e3, rng.standard_normal((200, 3))
+    assert exact.dot_cols(a.T, b.T).tobytes() == exact.dot_rows(a, b).tobytes()
+    assert exact.norm_cols(a.T).tobytes() == exact.norm_rows(a).tobytes()
+    scratch, out = np.empty((3, 200)), np.empty(200)
+    assert exact.norm_cols(np.ascontiguousarray(a.T), scratch, out).tobytes() == exact.norm_rows(a).tobytes()
+    assert exact.cross_cols(a.T, b.T).tobytes() == np.ascontiguousarray(exact.cross_rows(a, b).T).tobytes()
+    column = np.array([1.0, 2.0**-53, 2.0**-53])[:, None]
+    assert exact.dot_cols(column, np.ones((3, 1)))[0] == 1.0  # first to last, as dot_rows
+
+
+def test_a_correctly_rounded_total_does_not_depend_on_the_order():
+    x = np.array([1.0, 2.0**-53, 2.0**-53])
+    assert exact.correctly_rounded_total(x) == exact.correctly_rounded_total(x[::-1]) == 1.0 + 2.0**-52
+    assert exact.total(x) == 1.0  # one addition at a time loses the small terms

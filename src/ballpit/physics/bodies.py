@@ -231,7 +231,7 @@ class Plane(_Body):
     def signed_distance(self, points: object) -> np.ndarray | float:
         """Signed distance of points from the plane's infinite extension, positive on the normal's side."""
         p = np.asarray(points, float)
-        d = exact.dot(p - self.position, self.normal)
+        d = exact.dot_rows(p - self.position, self.normal)
         return float(d) if p.ndim == 1 else d
 
     def closest_point(self, points: object) -> np.ndarray:

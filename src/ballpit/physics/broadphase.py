@@ -211,9 +211,9 @@ def sphere_plane_pairs(
     spheres, planes = [], []
     for p in range(len(center)) if only is None else only.tolist():
         d = box_center - center[p]
-        du = np.abs(exact.dot(d, axis_u[p])) - half_size[p, 0]
-        dv = np.abs(exact.dot(d, axis_v[p])) - half_size[p, 1]
-        dn = exact.dot(d, normal[p])
+        du = np.abs(exact.dot_rows(d, axis_u[p])) - half_size[p, 0]
+        dv = np.abs(exact.dot_rows(d, axis_v[p])) - half_size[p, 1]
+        dn = exact.dot_rows(d, normal[p])
         # distance from the box centre to the rectangle, against the box's bounding-sphere radius
         dist2 = np.maximum(du, 0.0) ** 2 + np.maximum(dv, 0.0) ** 2 + dn**2
         if sweep is None:

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import exact
 from .settings import NO_ZERO_DIVIDE
 
 
@@ -68,27 +69,6 @@ def softness(hertz: float, zeta: float, h: float) -> Softness:
     a2 = h * omega * a1
     a3 = 1.0 / (1.0 + a2)
     return Softness(omega / a1, a2 * a3, a3)
-
-
-def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Column-wise a · b of (3, K) arrays, summed x, y, z in that order."""
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """Column-wise a × b of (3, K) arrays (each component as ``np.cross`` forms it), into ``out`` if
-    given (it must not overlap ``a`` or ``b``)."""
-    if out is None:
-        out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    for i in range(3):
-        cross_component(a, b, i, out=out[i])
-    return out
-
-
-def cross_component(a: np.ndarray, b: np.ndarray, i: int, out: np.ndarray | None = None) -> np.ndarray:
-    """Component ``i`` of the column-wise a × b: a_j·b_k − a_k·b_j with (i, j, k) in cyclic order."""
-    j, k = (i + 1) % 3, (i + 2) % 3
-    return np.subtract(a[j] * b[k], a[k] * b[j], out=out)
 
 
 def inverse_effective_masses(
@@ -151,7 +131,7 @@ def point_velocity(
 ) -> np.ndarray:
     """``contact_velocity`` from the relative velocity ``dv`` = v_a − v_b (changed in place and
     returned) and the ``spin_lever``: dv + n × lever − surface."""
-    dv += cross(n, lever)
+    dv += exact.cross_cols(n, lever)
     if surface is not None:
         dv -= surface
     return dv
@@ -162,9 +142,9 @@ def normal_speed(
 ) -> np.ndarray:
     """Each contact's normal speed v_n = (v_a − v_b)·n (negative: closing), against a moving plane's
     ``surface``; spin never changes it on spheres (a lever arm is parallel to n)."""
-    v_n = dot(v_a - v_b, n)
+    v_n = exact.dot_cols(v_a - v_b, n)
     if surface is not None:
-        v_n -= dot(surface, n)
+        v_n -= exact.dot_cols(surface, n)
     return v_n
 
 
@@ -207,4 +187,4 @@ def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np
 
 def turn(n: np.ndarray, tangential: np.ndarray) -> np.ndarray:
     """n × P_t: what a tangential impulse at the contact turns each ball by, times −ρ/I."""
-    return cross(n, tangential)
+    return exact.cross_cols(n, tangential)

@@ -71,7 +71,7 @@ def first_overlap(model: Model, state: State, position: object, radius: float) -
     r = validation.number("radius", radius, positive=True)
     balls = state.body[:, X] - p
     reach = model.spheres.radius + r
-    hit = np.flatnonzero(exact.dot(balls, balls) < reach * reach)
+    hit = np.flatnonzero(exact.dot_rows(balls, balls) < reach * reach)
     if hit.size:
         return f"ball {hit[0]}"
     pose, shape = state.planes, model.planes
@@ -81,7 +81,7 @@ def first_overlap(model: Model, state: State, position: object, radius: float) -
         points, k, pose.center, pose.axis_u, pose.axis_v, shape.half_size
     )
     gap = near - points
-    hit = np.flatnonzero(exact.dot(gap, gap) < r * r)
+    hit = np.flatnonzero(exact.dot_rows(gap, gap) < r * r)
     return f"plane {hit[0]}" if hit.size else None
 
 

@@ -21,4 +21,4 @@ def kinetic(model: Model, state: State) -> float:
 
 def potential(model: Model, state: State) -> float:
     """Gravitational potential energy −Σ m·g·x (J), zero at the origin."""
-    return -exact.total(model.spheres.mass * exact.dot(state.body[:, X], model.gravity))
+    return -exact.total(model.spheres.mass * exact.dot_rows(state.body[:, X], model.gravity))

@@ -30,7 +30,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import exact
-from .contact_model import dot
 from .state import V, W, X
 
 if TYPE_CHECKING:
@@ -65,12 +64,9 @@ def keep_impulses(
     mass = model.spheres.mass[balls]
     inertia = 1.0 / model.spheres.inv_inertia[balls]
 
-    def dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return x[:, 0] * y[:, 0] + x[:, 1] * y[:, 1] + x[:, 2] * y[:, 2]
-
-    # exact sums (math.fsum): the same bits on every CPU
-    b = math.fsum(mass * dot(v0, dv)) + math.fsum(inertia * dot(w0, dw))
-    a = math.fsum(mass * dot(dv, dv)) + math.fsum(inertia * dot(dw, dw))
+    dot, total = exact.dot_rows, exact.correctly_rounded_total
+    b = total(mass * dot(v0, dv)) + total(inertia * dot(w0, dw))
+    a = total(mass * dot(dv, dv)) + total(inertia * dot(dw, dw))
     if b + 0.5 * a <= 0.0 or a == 0.0:
         return 1.0
     s = max(0.0, -2.0 * b / a)
@@ -115,11 +111,11 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, p
     if moved.size == 0:
         return
     mass = model.spheres.mass[moved]
-    lift = -exact.total(mass * exact.dot(new[moved] - old[moved], model.gravity))
+    lift = -exact.total(mass * exact.dot_rows(new[moved] - old[moved], model.gravity))
     if lift <= 0.0:
         return
     v = state.body[moved, V]
-    kinetic = 0.5 * exact.total(mass * exact.dot(v, v))
+    kinetic = 0.5 * exact.total(mass * exact.dot_rows(v, v))
     if partly and kinetic < lift:
         new[moved] = old[moved] + (kinetic / lift) * (new[moved] - old[moved])
     scale = np.sqrt(max(0.0, 1.0 - lift / kinetic)) if kinetic > 0.0 else 0.0
@@ -153,18 +149,18 @@ def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray
 
     def energy(rows: np.ndarray) -> tuple[float, float]:
         v, w, x = rows[:, V], rows[:, W], rows[:, X]
-        kinetic = 0.5 * (mass * dot(v.T, v.T) + inertia * dot(w.T, w.T))
-        potential = -mass * (x[:, 0] * g[0] + x[:, 1] * g[1] + x[:, 2] * g[2])
-        return float(np.cumsum(kinetic)[-1]), float(np.cumsum(potential)[-1])
+        kinetic = 0.5 * (mass * exact.dot_rows(v, v) + inertia * exact.dot_rows(w, w))
+        potential = -mass * exact.dot_rows(x, g)
+        return exact.total(kinetic), exact.total(potential)
 
     k0, u0 = energy(old)
     k1, u1 = energy(new)
     if k1 + u1 <= k0 + u0:
         return
-    total = float(np.cumsum(mass)[-1])
+    total = exact.total(mass)
     v, w = new[:, V], new[:, W]
     momentum = mass[:, None] * v
-    v_cm = np.array([float(np.cumsum(momentum[:, i])[-1]) for i in range(3)]) / total
+    v_cm = np.array([exact.total(momentum[:, i]) for i in range(3)]) / total
     k_cm = 0.5 * total * float(v_cm[0] ** 2 + v_cm[1] ** 2 + v_cm[2] ** 2)
     k_rel = k1 - k_cm
     room = k0 + u0 - u1 - k_cm
@@ -173,10 +169,8 @@ def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray
     state.body[balls, W] = scale * w
     if room < 0.0:  # the rise is more than the motion can pay: take the rising balls part way back
         x0, x1 = old[:, X], new[:, X]
-        rise = -mass * (
-            (x1[:, 0] - x0[:, 0]) * g[0] + (x1[:, 1] - x0[:, 1]) * g[1] + (x1[:, 2] - x0[:, 2]) * g[2]
-        )
+        rise = -mass * exact.dot_rows(x1 - x0, g)
         up = rise > 0.0
-        lifted = float(np.cumsum(np.where(up, rise, 0.0))[-1])
+        lifted = exact.total(np.where(up, rise, 0.0))
         fraction = min(max(1.0 + room / lifted, 0.0), 1.0) if lifted > 0.0 else 1.0
         state.body[balls[up], 0:3] = x0[up] + fraction * (x1[up] - x0[up])

@@ -1,4 +1,12 @@
-"""Arithmetic whose bits do not depend on the CPU, for everything a step computes.
+"""Arithmetic whose bits do not depend on the CPU, for everything a step computes: the one module of
+vectors and sums.
+
+Vectors come in two layouts, named apart: rows, (..., 3) arrays with one vector a row (ball states,
+contact points; ``dot_rows``, ``norm_rows``, ``cross_rows`` work over the last axis), and columns,
+(3, K) arrays with one vector a column (the solves' contacts, contact_model.py; ``dot_cols``,
+``norm_cols``, ``cross_cols``). Either way a dot product sums x, y, z from first to last. A sum of many
+numbers is ``total`` (first to last, one addition at a time), or ``correctly_rounded_total`` where the
+sign of a tiny sum decides something.
 
 A scene gives the same bits on any x86-64 machine only if every operation in the step does. These do:
 elementwise +, −, ×, ÷ and sqrt are correctly rounded (IEEE 754) on every CPU and SIMD width, and a
@@ -20,6 +28,8 @@ scenes under each switch.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 # π/2 in three pieces for Cody–Waite reduction (fdlibm's e_rem_pio2.c): the first two have 33
@@ -39,8 +49,9 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 _MAX_ANGLE = 2.0**19 * np.pi
 
 
-def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a · b over the last axis, summed from first to last: (a₀b₀ + a₁b₁) + a₂b₂ for 3-vectors."""
+def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a · b of vectors laid out as rows (over the last axis), summed from first to last:
+    (a₀b₀ + a₁b₁) + a₂b₂ for 3-vectors."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     out = a[..., 0] * b[..., 0]
     for k in range(1, max(a.shape[-1], b.shape[-1])):
@@ -48,17 +59,23 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def norm(a: np.ndarray) -> np.ndarray:
-    """|a| over the last axis, its squares summed from first to last (as ``np.linalg.norm(a,
+def norm_rows(a: np.ndarray) -> np.ndarray:
+    """|a| of rows (over the last axis), its squares summed from first to last (as ``np.linalg.norm(a,
     axis=-1)`` sums them for rows of a matrix, but without its dot product for a single vector)."""
-    return np.sqrt(dot(a, a))
+    return np.sqrt(dot_rows(a, a))
 
 
 def total(x: np.ndarray) -> float:
     """Σx from first to last, one addition at a time (an accumulation is sequential by definition,
-    unlike a matrix product's kernel)."""
+    unlike a matrix product's kernel): the step's sum of many numbers."""
     x = np.ravel(x)
     return float(np.cumsum(x)[-1]) if x.size else 0.0
+
+
+def correctly_rounded_total(x: np.ndarray) -> float:
+    """Σx correctly rounded (``math.fsum``): independent of the order, for the impulses' energy check,
+    whose sign decides whether impulses are scaled (energy_guard.keep_impulses)."""
+    return math.fsum(x)
 
 
 def sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,8 +112,8 @@ def sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return sin, cos
 
 
-def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """p × q over the last axis of (..., 3) arrays, as ``np.cross`` forms each component
+def cross_rows(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """p × q of rows (over the last axis of (..., 3) arrays), as ``np.cross`` forms each component
     (p₁q₂ − p₂q₁, p₂q₀ − p₀q₂, p₀q₁ − p₁q₀), so the bits are the same, without its axis shuffling,
     which costs several times the arithmetic on a few rows."""
     p, q = np.asarray(p, float), np.asarray(q, float)
@@ -107,3 +124,36 @@ def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     np.subtract(p2 * q0, p0 * q2, out=out[..., 1])
     np.subtract(p0 * q1, p1 * q0, out=out[..., 2])
     return out
+
+
+def dot_cols(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a · b of vectors laid out as columns ((3, K) arrays, over the first axis), summed x, y, z in that
+    order: the same sums as ``dot_rows`` of the rows."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def norm_cols(a: np.ndarray, scratch: np.ndarray | None = None, out: np.ndarray | None = None) -> np.ndarray:
+    """|a| of columns ((3, K)), its squares summed x, y, z in that order (``dot_cols``); into ``out``
+    through ``scratch`` ((3, K)) when given, so a caller looping over chunks makes no temporaries."""
+    if scratch is None:
+        return np.sqrt(dot_cols(a, a))
+    np.multiply(a, a, out=scratch)
+    np.add(scratch[0], scratch[1], out=out)
+    out += scratch[2]
+    return np.sqrt(out, out=out)
+
+
+def cross_cols(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """a × b of columns ((3, K) arrays), each component as ``np.cross`` forms it, into ``out`` if given
+    (it must not overlap ``a`` or ``b``)."""
+    if out is None:
+        out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    for i in range(3):
+        cross_col(a, b, i, out=out[i])
+    return out
+
+
+def cross_col(a: np.ndarray, b: np.ndarray, i: int, out: np.ndarray | None = None) -> np.ndarray:
+    """Component ``i`` of the column-wise a × b: a_j·b_k − a_k·b_j with (i, j, k) in cyclic order."""
+    j, k = (i + 1) % 3, (i + 2) % 3
+    return np.subtract(a[j] * b[k], a[k] * b[j], out=out)

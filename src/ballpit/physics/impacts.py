@@ -56,13 +56,6 @@ from .settings import (
 from .state import State, V, W, with_static
 
 
-def normal_speeds(rows: ContactRows, v: np.ndarray) -> np.ndarray:
-    """Each contact's normal speed v_n (negative: closing), from the (N+1, 3) velocities ``v`` (row N the
-    static world), relative to a moving plane's surface (``contact_model.normal_speed``)."""
-    v_a, v_b = np.take(v, rows.a, axis=0).T, np.take(v, rows.b, axis=0).T
-    return contact_model.normal_speed(v_a, v_b, rows.normal.T, rows.surface.T if rows.moving else None)
-
-
 def in_waves(
     model: Model,
     state: State,
@@ -90,7 +83,7 @@ def in_waves(
     waves = 0
     iterations = max(model.solver_iterations, WAVE_ITERATIONS)
     while waves < MAX_WAVES:
-        vn = normal_speeds(rows, v)
+        vn = rows.normal_speeds(v)
         arriving = (vn < min_normal_speed - APPROACH_SPEED) & (-vn > restitution_threshold)
         if not arriving.any():
             break
@@ -137,7 +130,7 @@ def stop_approaches(
     if len(c) == 0:
         return
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
-    vn = normal_speeds(rows, v)
+    vn = rows.normal_speeds(v)
     seeds = vn < min_normal_speed - APPROACH_SPEED
     if not seeds.any():
         return

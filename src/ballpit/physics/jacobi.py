@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import contact_model as model
+from . import exact
 from .contact_model import Impulses
 from .ends import Ends
 from .rows import ContactRows
@@ -77,6 +78,13 @@ class ContactColumns(Ends):
         self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
         self.motion = np.empty((2, 3, k))
         self.split()
+
+    def normal_speeds(self, v: np.ndarray) -> np.ndarray:
+        """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it
+        on spheres), against a moving plane's surface: the contact model's ``normal_speed`` on these
+        columns."""
+        g = np.take(v[:3], self.ends, axis=1)
+        return model.normal_speed(g[:, : self.k], g[:, self.k :], self.n, self.surface)
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
@@ -165,13 +173,6 @@ def sweeps(
     return normal, tangential
 
 
-def normal_speeds(c: Ends, v: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None) -> np.ndarray:
-    """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it on
-    spheres), against a moving plane's ``surface``."""
-    g = np.take(v[:3], c.ends, axis=1)
-    return model.normal_speed(g[:, : c.k], g[:, c.k :], n, surface)
-
-
 def apply(
     c: ContactColumns, vw: np.ndarray, push: np.ndarray, normal: np.ndarray, tangential: np.ndarray
 ) -> None:
@@ -188,7 +189,7 @@ def apply(
     np.multiply(normal, c.n, out=linear)
     linear += d_t
     np.negative(linear, out=push[:3, k:])
-    model.cross(c.n, d_t, out=turn)  # model.turn: n × P_t
+    exact.cross_cols(c.n, d_t, out=turn)  # model.turn: n × P_t
     np.multiply(turn, c.minus_ra, out=push[3:, :k])
     push[3:, :k] += d_r
     turn *= c.minus_rb
@@ -213,7 +214,7 @@ def _apply_by_rows(
         np.negative(at_a, out=at_b)
         total[r] = c.add_row(row)
     for r in range(3):  # Δω: −ρ·(n × P_t) ± R
-        model.cross_component(n, d_t, r, out=at_b)
+        exact.cross_col(n, d_t, r, out=at_b)
         np.multiply(at_b, c.minus_ra, out=at_a)
         at_a += d_r[r]
         at_b *= c.minus_rb
@@ -235,7 +236,7 @@ def _normal_sweep(
 ) -> np.ndarray:
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
-    vn = normal_speeds(c, vw, n, c.surface)
+    vn = c.normal_speeds(vw)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     if len(push) == 1:  # one row at a time (``apply``)
@@ -282,7 +283,7 @@ def _full_sweep(
     dv -= np.take(vw[:3], eb, axis=1)
     rel = model.point_velocity(dv, lever, n, c.surface)
     del lever
-    vn = model.dot(rel, n)
+    vn = exact.dot_cols(rel, n)
     new = model.normal_impulse(normal, m_n, target, vn, give)
     d_n = new - normal
     # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin

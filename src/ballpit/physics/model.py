@@ -123,8 +123,7 @@ class Model:
         spin = self.planes.angular_velocity
         if not spin.any():
             return spin
-        x, y, z = spin[:, 0], spin[:, 1], spin[:, 2]
-        still = (x * x + y * y) + z * z < SLOWEST_TURN * SLOWEST_TURN
+        still = exact.dot_rows(spin, spin) < SLOWEST_TURN * SLOWEST_TURN
         return np.where(still[:, None], 0.0, spin) if still.any() else spin
 
     def contact_slop(self) -> float:
@@ -151,4 +150,4 @@ class Model:
         """
         if self.restitution_threshold is not None:
             return self.restitution_threshold
-        return self.integrator.threshold_steps * float(exact.norm(self.gravity)) * dt
+        return self.integrator.threshold_steps * float(exact.norm_rows(self.gravity)) * dt

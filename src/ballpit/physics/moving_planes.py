@@ -84,7 +84,7 @@ def _turn(wx: float, wy: float, wz: float, rate: float, h: float) -> tuple[float
 def _store_orientation(pose: Columns, i: int, q: tuple[float, float, float, float]) -> None:
     """Store unit quaternion ``q`` of plane ``i`` and the axes it turns x, y and z to, each formed as
     ``quaternion.rotate`` forms it (v + w·t + u × t with t = 2·u × v, u the vector part, and
-    ``exact.cross``'s order), the normal divided by its length (``exact.norm``)."""
+    ``exact.cross_rows``'s order), the normal divided by its length (``exact.norm_rows``)."""
     ux, uy, uz, w = q
 
     def rotate(vx: float, vy: float, vz: float) -> tuple[float, float, float]:
@@ -107,7 +107,7 @@ def surface_velocity(model: Model, state: State, plane: np.ndarray, points: np.n
     """Velocity of the surface of ``plane[k]`` at ``points[k]``: v + ω × (p − c)."""
     pl = model.planes
     offset = points - state.planes.center[plane]
-    return pl.velocity[plane] + cross(model.plane_spin()[plane], offset)
+    return pl.velocity[plane] + exact.cross_rows(model.plane_spin()[plane], offset)
 
 
 def frames_at(model: Model, state: State, plane: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -125,13 +125,8 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     """How far a point of ``plane`` within ``distance`` of its centre can move in ``h``:
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
-    shift = _length(pl.velocity[plane].tolist()) * h
-    return shift + _length(model.plane_spin()[plane].tolist()) * h * (distance + shift)
-
-
-def _length(x: list[float]) -> float:
-    """|x| of one 3-vector in Python floats, its squares summed in ``exact.norm``'s order."""
-    return math.sqrt((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
+    shift = float(exact.norm_rows(pl.velocity[plane])) * h
+    return shift + float(exact.norm_rows(model.plane_spin()[plane])) * h * (distance + shift)
 
 
 def closing_speed_bound(
@@ -145,8 +140,3 @@ def closing_speed_bound(
     linear = np.linalg.norm(dv, axis=1) + np.linalg.norm(acc, axis=1) * h
     far = np.linalg.norm(state.body[ball, 0:3] - state.planes.center[plane], axis=1) + linear * h
     return linear + np.linalg.norm(model.plane_spin()[plane], axis=1) * far
-
-
-def cross(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Row-wise p × q of (K, 3) arrays (``exact.cross``: np.cross costs several times more on a few rows)."""
-    return exact.cross(p, q)

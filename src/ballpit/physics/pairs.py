@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import broadphase, moving_planes
+from . import broadphase, exact, moving_planes
 from .integrators import Integrator
 from .model import Model
 from .settings import (
@@ -110,23 +110,14 @@ class KeptPairs:
                 return True
             # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
             np.subtract(xs, centre[:, rows], out=ds)
-            _norm(ds, es, fars)
+            exact.norm_cols(ds, es, fars)
             np.subtract(ends, centre[:, rows], out=ds)
-            _norm(ds, es, tmps)
+            exact.norm_cols(ds, es, tmps)
             np.maximum(fars, tmps, out=fars)
             fars += pads
             if np.any(fars > self.reach[rows]):
                 return True
         return False
-
-
-def _norm(a: np.ndarray, scratch: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """The length of each column of ``a`` (3, m), as ``np.linalg.norm(rows, axis=1)`` gives it:
-    sqrt((x² + y²) + z²), summed in that order."""
-    np.multiply(a, a, out=scratch)
-    np.add(scratch[0], scratch[1], out=out)
-    out += scratch[2]
-    return np.sqrt(out, out=out)
 
 
 class PairCache:
@@ -218,7 +209,8 @@ def find_pairs(
     ones do not drag big boxes through a crowd.
 
     The paths are ``Integrator.path_end`` on contiguous (3, N) columns, and their lengths are
-    ``np.linalg.norm`` over rows as ``_norm`` forms it on columns (its three squares summed in order).
+    ``np.linalg.norm`` over rows as ``exact.norm_cols`` forms it on columns (three squares summed in
+    order).
     """
     body, radius = state.body, model.spheres.radius
     path: Integrator = model.integrator
@@ -226,13 +218,13 @@ def find_pairs(
     x, v = np.ascontiguousarray(body[:, X].T), np.ascontiguousarray(body[:, V].T)
     accel_t, free_t = accel.T, free.T
     scratch = np.empty((3, n))
-    speed = _norm(v, scratch, np.empty(n))
+    speed = exact.norm_cols(v, scratch, np.empty(n))
     horizon = np.clip(BROAD_PHASE_REACH * radius / np.maximum(speed, TINY), h, max(h, ahead))
     now = path.path_end(x, v, accel_t, h)
     later = path.path_end(x, v, free_t, horizon)
     # how far the paths can stray from their chords, over this step and over the horizon
-    free_norm = _norm(free_t, scratch, np.empty(n))
-    accel_norm = free_norm if accel is free else _norm(accel_t, scratch, np.empty(n))
+    free_norm = exact.norm_cols(free_t, scratch, np.empty(n))
+    accel_norm = free_norm if accel is free else exact.norm_cols(accel_t, scratch, np.empty(n))
     sag = path.cover_sag(accel_norm, h) + path.cover_sag(free_norm, horizon)
     pad = radius + sag + BROAD_PHASE_MARGIN * radius + model.contact_slop()
     lo = np.minimum(x, now)
@@ -242,7 +234,7 @@ def find_pairs(
     centre = lo + hi
     centre *= 0.5
     np.subtract(hi, lo, out=scratch)
-    reach = _norm(scratch, scratch, np.empty(n))
+    reach = exact.norm_cols(scratch, scratch, np.empty(n))
     reach *= 0.5
     reach += pad
     lo -= pad

@@ -53,7 +53,7 @@ def separate(
     proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world.
 
     Every sweep works one coordinate at a time, on (K,) and (2K,) rows: the same operations in the same
-    order as on (3, K) blocks (v_n as ``contact_model.dot`` sums it, each row added up as ``add_up``
+    order as on (3, K) blocks (v_n as ``exact.dot_cols`` sums it, each row added up as ``add_up``
     does), without their memory."""
     e = Ends(a, b)
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
@@ -86,12 +86,12 @@ def separate(
 def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) -> None:
     """Gauss–Seidel sweeps over the contact colours; ``pos`` (N+1, 3) changes in place."""
     n = c.normal
-    offset = exact.dot(n, pos[c.a] - pos[c.b]) - c.gap
+    offset = exact.dot_rows(n, pos[c.a] - pos[c.b]) - c.gap
     part_a, part_b = contact_model.separation_parts(rows.inv_mass_a, rows.inv_mass_b)
     for _ in range(PENETRATION_SWEEPS):
         for idx in rows.colours:
             a, b = c.a[idx], c.b[idx]
-            gap = exact.dot(n[idx], pos[a] - pos[b]) - offset[idx]
+            gap = exact.dot_rows(n[idx], pos[a] - pos[b]) - offset[idx]
             depth = np.maximum(-gap, 0.0)[:, None] * n[idx]
             pos[a] += depth * part_a[idx, None]
             pos[b] += depth * part_b[idx, None]
@@ -117,8 +117,8 @@ def keep_sides_of_planes(
     start, path = old[moved], new[moved] - old[moved]
     t = np.ones(len(moved))
     for p in range(model.planes.count):
-        d0 = exact.dot(start - pose.center[p], pose.normal[p])
-        d1 = d0 + exact.dot(path, pose.normal[p])
+        d0 = exact.dot_rows(start - pose.center[p], pose.normal[p])
+        d1 = d0 + exact.dot_rows(path, pose.normal[p])
         crossing = (d0 >= 0.0) != (d1 >= 0.0)
         # nor is a ball moved into a plane, deeper than it touched or overlapped it, by more than
         # HOLD_SINK of its radius: that plane's contact may not be among the interval's touching
@@ -133,8 +133,8 @@ def keep_sides_of_planes(
             crossing[k, None], start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k], new[moved[k]]
         )
         rel = through - pose.center[p]
-        inside = (np.abs(exact.dot(rel, pose.axis_u[p])) <= half[p, 0]) & (
-            np.abs(exact.dot(rel, pose.axis_v[p])) <= half[p, 1]
+        inside = (np.abs(exact.dot_rows(rel, pose.axis_u[p])) <= half[p, 0]) & (
+            np.abs(exact.dot_rows(rel, pose.axis_v[p])) <= half[p, 1]
         )
         k = k[inside]
         # stop at the signed distance ±min(r, |d0|): touching it, on the side the ball came from

@@ -41,8 +41,8 @@ def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     v = np.asarray(v, float)
     u = q[..., :3]
     w = q[..., 3:4]
-    t = 2.0 * exact.cross(u, v)
-    return v + w * t + exact.cross(u, t)
+    t = 2.0 * exact.cross_rows(u, v)
+    return v + w * t + exact.cross_rows(u, t)
 
 
 def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
@@ -68,7 +68,7 @@ def from_up_to(normal: np.ndarray) -> np.ndarray:
     """The shortest rotation taking +y to the unit vector ``normal`` (180° about x when it is −y)."""
     n = np.asarray(normal, float)
     up = np.array([0.0, 1.0, 0.0])
-    d = float(exact.dot(up, n))
+    d = float(exact.dot_rows(up, n))
     if d < -1.0 + ANTIPARALLEL:
         return np.array([1.0, 0.0, 0.0, 0.0])
     # q = (up × n, 1 + up·n) normalised is the half-angle form of the rotation between them.

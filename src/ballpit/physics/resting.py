@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import contact_model, exact, solver
+from . import exact, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
@@ -54,7 +54,8 @@ class WarmStart:
         imp.normal[found] = self.forces.normal[src] * h
         friction = self.forces.friction[src] * h
         n = normal[found]
-        imp.friction[found] = friction - exact.dot(friction, n)[:, None] * n  # onto today's tangent plane
+        # onto today's tangent plane
+        imp.friction[found] = friction - exact.dot_rows(friction, n)[:, None] * n
         imp.rolling[found] = self.forces.rolling[src] * h
         return imp
 
@@ -228,7 +229,7 @@ def hold_by_planes(
     if not static.any():
         return
     n = rows.normal
-    vn0, vn1 = _normal_speeds(rows, v_start), _normal_speeds(rows, v)
+    vn0, vn1 = rows.normal_speeds(v_start), rows.normal_speeds(v)
     r = radius[rows.a]
     sink = 0.5 * h * (vn0 + vn1)
     deeper = static & (gap + sink < np.minimum(gap, 0.0) - HOLD_SINK * r)
@@ -250,8 +251,10 @@ def hold_by_planes(
             # each end's normal speed change per unit impulse: 1/m, or |P·n|²/m for a held ball
             pa = np.where(held[a, None], _off(basis[slot[a]], nk), nk)
             pb = np.where(held[b, None], _off(basis[slot[b]], nk), nk)
-            inverse = exact.dot(pa, pa) * rows.inv_mass_a[idx] + exact.dot(pb, pb) * rows.inv_mass_b[idx]
-            closing = np.maximum(target[idx] - exact.dot(v[a] - v[b], nk), 0.0)
+            inverse = (
+                exact.dot_rows(pa, pa) * rows.inv_mass_a[idx] + exact.dot_rows(pb, pb) * rows.inv_mass_b[idx]
+            )
+            closing = np.maximum(target[idx] - exact.dot_rows(v[a] - v[b], nk), 0.0)
             j = np.where(inverse > 0.0, closing / np.where(inverse > 0.0, inverse, 1.0), 0.0)
             normal[idx] += j
             # the whole impulse acts on both balls; the planes take a held ball's part off it below
@@ -275,19 +278,12 @@ def _plane_bases(rows: ContactRows, held: np.ndarray, pushing: np.ndarray) -> tu
     for group in rows.subset(pushing).colours:  # one contact per ball in each colour
         k = slot[rows.a[pushing[group]]]
         u = _off(basis[k], rows.normal[pushing[group]])
-        length = exact.norm(u)
+        length = exact.norm_rows(u)
         ok = (length > NEW_DIRECTION) & (count[k] < 3)
         k = k[ok]
         basis[k, count[k]] = u[ok] / length[ok, None]
         count[k] += 1
     return slot, basis
-
-
-def _normal_speeds(rows: ContactRows, v: np.ndarray, idx: np.ndarray | slice = slice(None)) -> np.ndarray:
-    """v_n of the contacts ``idx`` under the (N+1, 3) velocities ``v``, against a moving surface: the
-    contact model's ``normal_speed`` on these rows."""
-    surface = rows.surface[idx].T if rows.moving else None
-    return contact_model.normal_speed(v[rows.a[idx]].T, v[rows.b[idx]].T, rows.normal[idx].T, surface)
 
 
 def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
@@ -296,7 +292,7 @@ def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
     u = n.copy()
     for j in range(3):
         e = basis[:, j]
-        u = u - exact.dot(u, e)[:, None] * e
+        u = u - exact.dot_rows(u, e)[:, None] * e
     return u
 
 
@@ -310,6 +306,6 @@ def _push_off_planes(
     for group in rows.subset(idx).colours:
         k = idx[group]
         a = rows.a[k]
-        j = np.maximum(target[k] - _normal_speeds(rows, v, k), 0.0) / rows.inv_mass_a[k]
+        j = np.maximum(target[k] - rows.normal_speeds(v, k), 0.0) / rows.inv_mass_a[k]
         normal[k] += j
         v[a] += (j * rows.inv_mass_a[k])[:, None] * rows.normal[k]

@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from . import exact, moving_planes
+from . import contact_model, exact, moving_planes
 from .contact_model import Impulses
 from .contacts import SPHERE_PLANE, ContactPoints, take_indices
 from .model import Model
@@ -51,12 +51,19 @@ class ContactRows:
         """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side, as the lengths
         of the lever arms −radius_a·n and radius_b·n (formed here and dropped: (K, 3) each)."""
         n = self.normal[idx]
-        return exact.norm(-self.radius_a[idx, None] * n), exact.norm(self.radius_b[idx, None] * n)
+        return exact.norm_rows(-self.radius_a[idx, None] * n), exact.norm_rows(self.radius_b[idx, None] * n)
 
     @cached_property
     def colours(self) -> list[np.ndarray]:
         """Groups of contacts sharing no ball, for the colour-by-colour sweeps (found when first asked)."""
         return colour(self.a, self.b, self.static)
+
+    def normal_speeds(self, v: np.ndarray, idx: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """Each contact's normal speed v_n (negative: closing) of the contacts ``idx``, from the (N+1, 3)
+        velocities ``v`` (row N the static world), against a moving plane's surface: the contact model's
+        ``normal_speed`` on these rows."""
+        surface = self.surface[idx].T if self.moving else None
+        return contact_model.normal_speed(v[self.a[idx]].T, v[self.b[idx]].T, self.normal[idx].T, surface)
 
     def subset(self, mask: np.ndarray) -> ContactRows:
         """The contacts where ``mask`` holds."""
@@ -174,22 +181,19 @@ def rows_at_end(
     axis = spin / np.array(rates)[plane, None]
     n = rows.normal[on]
     # Rodrigues: n·cos θ + (k × n)·sin θ + k·(k·n)·(1 − cos θ)
-    turned = n * cos + moving_planes.cross(axis, n) * sin + axis * (_dot(axis, n) * (1.0 - cos))
+    turned = (
+        n * cos + exact.cross_rows(axis, n) * sin + axis * (exact.dot_rows(axis, n)[:, None] * (1.0 - cos))
+    )
     push = (warm.normal[on, None] * n + warm.friction[on]) * (rows.inv_mass_a[on] / h)[:, None]
     body, radius = state.body, model.spheres.radius[ball, None]
     centre = model.integrator.path_end(body[ball, 0:3], body[ball, 3:6], lin[ball] + push, h)
     plane_centre = state.planes.center[plane] + pl.velocity[plane] * h
     normal, surface = rows.normal.copy(), rows.surface.copy()
     normal[on] = turned
-    surface[on] = pl.velocity[plane] + moving_planes.cross(spin, centre - radius * turned - plane_centre)
+    surface[on] = pl.velocity[plane] + exact.cross_rows(spin, centre - radius * turned - plane_centre)
     friction = warm.friction[on]
-    warm.friction[on] = friction - _dot(friction, turned) * turned
+    warm.friction[on] = friction - exact.dot_rows(friction, turned)[:, None] * turned
     end = replace(rows, normal=normal, surface=surface)  # the lever arms turn with the normal
     if "colours" in rows.__dict__:  # the same contacts: the same colours
         end.__dict__["colours"] = rows.colours
     return end
-
-
-def _dot(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Row-wise p·q as a (K, 1) column, summed in a fixed order."""
-    return p[:, 0:1] * q[:, 0:1] + p[:, 1:2] * q[:, 1:2] + p[:, 2:3] * q[:, 2:3]

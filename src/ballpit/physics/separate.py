@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import energy_guard, penetration
+from . import energy_guard, exact, penetration
 from .model import Model
 from .resting import WarmStart
 from .settings import MAX_PUSH, PENETRATION_TOLERANCE, SEPARATE_REACH, SEPARATE_SWEEPS, SLOP, SLOP_RETURN
@@ -89,7 +89,7 @@ def planes_win(f: SoftFrame, model: Model, state: State) -> None:
     s = c.gap[on] + d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2]
     if rows.moving:  # the plane's surface moves on over the frame too
         u = rows.surface[on]
-        s -= (u[:, 0] * nrm[:, 0] + u[:, 1] * nrm[:, 1] + u[:, 2] * nrm[:, 2]) * dt
+        s -= exact.dot_rows(u, nrm) * dt
     deficit = np.maximum(np.minimum(c.gap[on], -SLOP * model.spheres.radius[a]) - s, 0.0)
     if not (deficit > PENETRATION_TOLERANCE).any():
         return

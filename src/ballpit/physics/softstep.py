@@ -40,13 +40,12 @@ that carry the load.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import impacts, jacobi, quaternion, separate
-from .contact_model import Impulses, dot, softness
+from . import exact, impacts, jacobi, quaternion, separate
+from .contact_model import Impulses, softness
 from .contacts import ContactPoints
 from .forces import ForceTerm, column_accelerations, constant_acceleration, forces_of
 from .model import Model
@@ -166,13 +165,13 @@ class SoftFrame:
         self.ends_a, self.ends_b = k.ends[:kc], k.ends[kc:]
         self.on_plane = self.rows.b == n_balls
         # the surface's own speed along the normal (moving planes), to move their side of s
-        self.surface_n = dot(k.surface, k.n) if k.surface is not None else None
+        self.surface_n = exact.dot_cols(k.surface, k.n) if k.surface is not None else None
         hertz = min(CONTACT_HERTZ, SOFT_RATE_CAP / h)
         self.ball_soft, self.plane_soft = (
             softness(hertz, DAMPING_RATIO, h),
             softness(PLANE_STIFFNESS * hertz, DAMPING_RATIO, h),
         )
-        self.vn_start = _normal_speed(k, vw)  # recorded at the frame's start, for the restitution pass
+        self.vn_start = k.normal_speeds(vw)  # recorded at the frame's start, for the restitution pass
         self.keys = c.keys()
         imp = warm.impulses(self.keys, c.normal, h)
         self.apart = warm.apart_of(self.keys)
@@ -194,7 +193,9 @@ class SoftFrame:
         """s = s₀ + n·(Δx_a − Δx_b): each contact's separation from the balls' moved positions (and a
         moving plane's surface, moved by its speed along n for ``t``)."""
         d = self.x - self.x0
-        s = self.c.gap + dot(np.take(d, self.ends_a, axis=1) - np.take(d, self.ends_b, axis=1), self.n)
+        s = self.c.gap + exact.dot_cols(
+            np.take(d, self.ends_a, axis=1) - np.take(d, self.ends_b, axis=1), self.n
+        )
         if self.surface_n is not None:
             s -= self.surface_n * t
         return s
@@ -220,7 +221,7 @@ def solve(f: SoftFrame, i: int) -> None:
     gap."""
     k, vw, h = f.k, f.vw, f.h
     s = f.separation(i * h)
-    k.split((f.normal > 0.0) | (s + PUSH_AHEAD * np.minimum(_normal_speed(k, vw), 0.0) * h < 0.0))
+    k.split((f.normal > 0.0) | (s + PUSH_AHEAD * np.minimum(k.normal_speeds(vw), 0.0) * h < 0.0))
     speculative = s > 0.0
     target = np.where(speculative, -s / h, np.minimum(-f.soft("bias_rate") * (s - f.apart), MAX_PUSH))
     scale = np.where(speculative, 1.0, f.soft("mass_scale"))
@@ -236,9 +237,9 @@ def integrate_positions(f: SoftFrame) -> None:
     f.x[:, live] += f.vw[:3, live] * f.h
     quaternion.turn(f.q, f.vw[3:, live], f.h)
     moved = f.x[:, live] - before
-    np.maximum(f.largest[live], _length(moved), out=f.largest[live])
+    np.maximum(f.largest[live], exact.norm_cols(moved), out=f.largest[live])
     del before, moved
-    np.maximum(f.farthest[live], _length(f.x[:, live] - f.x0[:, live]), out=f.farthest[live])
+    np.maximum(f.farthest[live], exact.norm_cols(f.x[:, live] - f.x0[:, live]), out=f.farthest[live])
     np.minimum(f.lo, f.x[:, live], out=f.lo)
     np.maximum(f.hi, f.x[:, live], out=f.hi)
 
@@ -289,9 +290,7 @@ def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, ad
     the impact's compression, which warm-started again would push apart the balls the waves left
     still."""
     g, n = model.gravity, f.n
-    level = np.abs(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) <= LEVEL * math.sqrt(
-        g[0] * g[0] + g[1] * g[1] + g[2] * g[2]
-    )
+    level = np.abs(exact.dot_cols(g, n)) <= LEVEL * exact.norm_rows(g)
     kept = np.where((added != 0.0) & level, np.minimum(f.normal, f.came_with), f.normal)
     warm.keep(f.keys, Impulses(kept, f.tangential[0].T.copy(), f.tangential[1].T.copy()), f.h)
     body, idx, live = state.body, f.idx, f.live
@@ -302,16 +301,6 @@ def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, ad
     # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now
     f.whole = f.k.whole
     f.k = f.vw = f.q = f.tangential = f.came_with = f.vn_start = None
-
-
-def _normal_speed(k: jacobi.ContactColumns, vw: np.ndarray) -> np.ndarray:
-    """Each contact's relative normal speed v_n = (v_a − v_b)·n (spin does not change it on spheres),
-    against a moving plane's surface."""
-    return jacobi.normal_speeds(k, vw, k.n, k.surface)
-
-
-def _length(a: np.ndarray) -> np.ndarray:
-    return np.sqrt(dot(a, a))
 
 
 def _soft_sweeps(

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import contact_model as model
-from . import jacobi
+from . import exact, jacobi
 from .contact_model import Impulses
 from .ends import Ends
 from .rows import ContactRows
@@ -128,7 +128,7 @@ def _sweep_colour(
     ga, gb = np.take(vw, c.a, axis=1), np.take(vw, c.b, axis=1)
     va, wa, vb, wb = ga[:3], ga[3:], gb[:3], gb[3:]
     rel = model.contact_velocity(va, wa, vb, wb, c.n, c.ra, c.rb, c.surface)
-    vn = model.dot(rel, c.n)
+    vn = exact.dot_cols(rel, c.n)
 
     old = normal[k]
     new = model.normal_impulse(old, c.m_n, target, vn)

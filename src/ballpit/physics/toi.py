@@ -139,11 +139,6 @@ def meetings(
     return first_contact(gap_at, bound, h, goal, start=start), bound, apart
 
 
-def _dot(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Row-wise p·q, summed in a fixed order."""
-    return p[:, 0] * q[:, 0] + p[:, 1] * q[:, 1] + p[:, 2] * q[:, 2]
-
-
 def earliest(
     model: Model,
     state: State,
@@ -174,17 +169,17 @@ def earliest(
     a, b = c.a[apart], c.b[apart]
     e = c.normal[apart]
     dv, da = v[a] - v[b], acc[a] - acc[b]
-    slope, curve = _dot(e, dv), _dot(e, da)
+    slope, curve = exact.dot_rows(e, dv), exact.dot_rows(e, da)
     if model.moving_planes():
         on = np.flatnonzero(c.kind[apart] == SPHERE_PLANE)
         pl, k = model.planes, c.other[apart[on]]
         spin, rel = model.plane_spin()[k], dv[on] - pl.velocity[k]  # v − v_p
-        w = rel - exact.cross(spin, x[a[on]] - state.planes.center[k])
-        norm = lambda q: np.sqrt(_dot(q, q))  # noqa: E731
+        w = rel - exact.cross_rows(spin, x[a[on]] - state.planes.center[k])
+        norm = exact.norm_rows
         rate, accel = norm(spin), norm(da[on])
         speed = norm(rel) + accel * h  # |v − v_p| over the interval
         turn = norm(w) + h * (accel + rate * speed)  # |w| over the interval
-        slope[on] = _dot(e[on], w)
+        slope[on] = exact.dot_rows(e[on], w)
         curve[on] -= rate * (accel * h + turn + speed)
     depth = c.gap[apart] - goal
     root = slope * slope - 2.0 * curve * depth

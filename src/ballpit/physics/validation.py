@@ -113,7 +113,7 @@ def unit_vector(name: str, value: object) -> np.ndarray:
     biggest = float(np.abs(v).max())
     if biggest > 1.0:
         v = v / biggest
-    norm = float(exact.norm(v))
+    norm = float(exact.norm_rows(v))
     if norm < TINY:
         raise ValueError(f"{name} must not be a zero vector, got {value!r}")
     return v / norm
@@ -125,7 +125,7 @@ def quaternion(name: str, value: object) -> np.ndarray:
     biggest = float(np.abs(q).max())
     if biggest > 1.0:
         q = q / biggest
-    norm = float(exact.norm(q))
+    norm = float(exact.norm_rows(q))
     if norm < TINY:
         raise ValueError(f"{name} must not be a zero quaternion, got {value!r}")
     return q / norm

@@ -311,7 +311,7 @@ def _ball_property(e: Entry, key: str) -> object:
         return e.vector(key, None)
     if key == "orientation":
         q = e.nonzero_vector(key, 4)
-        return q / exact.norm(q)
+        return q / exact.norm_rows(q)
     if key == "restitution":
         return e.number(key, None, within=schema.RESTITUTION_RANGE)
     if key == "hollow":

@@ -10,7 +10,7 @@ from enum import Enum
 
 import numpy as np
 
-from .. import collision, energy_guard, moving_planes, narrowphase, softstep
+from .. import collision, energy_guard, exact, moving_planes, narrowphase, softstep
 from ..checkpoint import Checkpoint
 from ..contacts import SPHERE_PLANE, ContactPoints
 from ..forces import forces_of, free_acceleration
@@ -69,8 +69,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     radius = np.append(model.spheres.radius, np.inf)
     v, acc = state.body[:, V], motion.lin
     # each ball's speed and pull, and 0 for the static row N
-    speed = np.append(np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2]), 0.0)
-    pull = np.append(np.sqrt(acc[:, 0] * acc[:, 0] + acc[:, 1] * acc[:, 1] + acc[:, 2] * acc[:, 2]), 0.0)
+    speed, pull = np.append(exact.norm_rows(v), 0.0), np.append(exact.norm_rows(acc), 0.0)
     contacts = collision.take()
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < step.touching + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
@@ -170,7 +169,7 @@ def verdict(
     # how far each ball got from where it started (the others flew straight)
     far = np.zeros(n + 1)
     moved = state.body[:, X] - before[:, X]
-    far[:n] = np.sqrt(moved[:, 0] ** 2 + moved[:, 1] ** 2 + moved[:, 2] ** 2)
+    far[:n] = exact.norm_rows(moved)
     far[balls] = np.maximum(far[balls], frame.farthest[cols])
     kept = step.pairs.kept
     lo, hi = frame.lo, frame.hi
@@ -179,7 +178,7 @@ def verdict(
     escaped = (
         (lo - r < kept.lo[balls].T).any()
         or (hi + r > kept.hi[balls].T).any()
-        or (np.sqrt(corner[0] ** 2 + corner[1] ** 2 + corner[2] ** 2) + r > kept.reach[balls]).any()
+        or (exact.norm_cols(corner) + r > kept.reach[balls]).any()
     )
     if escaped:  # pairs around where the balls are now; those not solved are the ones left out
         free, _ = free_acceleration(state.body, motion.forces)
@@ -218,7 +217,7 @@ def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) 
         s, p = c.a[on_plane], c.other[on_plane]
         d = before[s, 0:3] - pose.center[p]
         nrm = pose.normal[p]
-        side = np.where(d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2] < 0.0, -1.0, 1.0)
+        side = np.where(exact.dot_rows(d, nrm) < 0.0, -1.0, 1.0)
         gap[on_plane] = collision.sphere_plane(
             x, radius, s, p, side, pose.center, pose.normal, pose.axis_u, pose.axis_v, model.planes.half_size
         )[0]
