@@ -11,8 +11,8 @@ import pytest
 import ballpit
 from ballpit.physics import impacts, narrowphase, rows
 from ballpit.physics.contacts import EventLog
-from ballpit.physics.energy_guard import EnergyGuards
 from ballpit.physics.forces import free_acceleration
+from ballpit.physics.settings import EnergyGuards
 
 G = 9.81
 

@@ -17,34 +17,20 @@ it moved, by the one factor that keeps what that stage must keep:
   the centre of mass and the spins are scaled (momentum and every direction kept); when the springs
   lifted the balls more than their motion can pay, the rising balls are taken back part way.
 
-Each guard is switched by ``Model.guards`` (``EnergyGuards``, all on by default), so a test can show
+Each guard is switched by ``Model.guards`` (``settings.EnergyGuards``, all on by default), so a test can show
 what each prevents; a world's results are those of the guards on.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import exact
-from .state import V, W, X
-
-if TYPE_CHECKING:
-    from .model import Model
-    from .rows import ContactRows
-    from .state import State
-
-
-@dataclass(frozen=True)
-class EnergyGuards:
-    """Which energy guards are on (the module's rule): all of them, unless a test switches one off."""
-
-    impulses: bool = True
-    lift: bool = True
-    frame: bool = True
+from .model import Model
+from .rows import ContactRows
+from .state import State, V, W, X
 
 
 def keep_impulses(

@@ -52,7 +52,10 @@ _MAX_ANGLE = 2.0**19 * np.pi
 def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a · b of vectors laid out as rows (over the last axis), summed from first to last:
     (a₀b₀ + a₁b₁) + a₂b₂ for 3-vectors."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
+    if not (type(a) is np.ndarray and a.dtype == np.float64):
+        a = np.asarray(a, float)
+    if not (type(b) is np.ndarray and b.dtype == np.float64):
+        b = np.asarray(b, float)
     out = a[..., 0] * b[..., 0]
     for k in range(1, max(a.shape[-1], b.shape[-1])):
         out = out + a[..., k] * b[..., k]

@@ -24,6 +24,7 @@ from . import quaternion
 from .forces import ForceTerm, constant_acceleration
 from .rk4_fast import rk4_constant
 from .state import Q, V, W, X
+from .workspace import Workspace
 
 
 def derivative(state: np.ndarray, forces: Sequence[ForceTerm], out: np.ndarray) -> np.ndarray:
@@ -36,22 +37,6 @@ def derivative(state: np.ndarray, forces: Sequence[ForceTerm], out: np.ndarray) 
         term.add(state, lin, ang)
     quaternion.derivative(state[:, Q], state[:, W], out[:, Q])
     return out
-
-
-class Workspace:
-    """Scratch arrays reused between steps so the hot path allocates nothing new."""
-
-    def __init__(self) -> None:
-        self._buffers: dict[tuple[str, tuple[int, ...]], np.ndarray] = {}
-
-    def get(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
-        key = (name, shape)
-        buf = self._buffers.get(key)
-        if buf is None:
-            if len(self._buffers) > 64:  # shapes change as balls are added; drop stale ones
-                self._buffers.clear()
-            buf = self._buffers[key] = np.empty(shape)
-        return buf
 
 
 def euler(state: np.ndarray, forces: Sequence[ForceTerm], h: float, ws: Workspace) -> None:

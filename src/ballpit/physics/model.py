@@ -10,10 +10,16 @@ from __future__ import annotations
 import numpy as np
 
 from . import exact
-from .energy_guard import EnergyGuards
 from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
 from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
-from .settings import CONTACT_SLOP, CROWD_LIMIT, SLOP_PER_RADIUS, SLOWEST_TURN, SOLVER_ITERATIONS
+from .settings import (
+    CONTACT_SLOP,
+    CROWD_LIMIT,
+    SLOP_PER_RADIUS,
+    SLOWEST_TURN,
+    SOLVER_ITERATIONS,
+    EnergyGuards,
+)
 from .state import Columns
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².

@@ -4,16 +4,11 @@ common case), worked on contiguous columns of a chunk of balls at a time."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from .settings import RK4_CHUNK
 from .state import Q
-
-if TYPE_CHECKING:
-    from .integrators import Workspace
-
+from .workspace import Workspace
 
 # The fast path's layout of a chunk, one ball per column: x, v, then q with its y and z repeated in
 # front (qy qz qx qy qz qw) and ω with its x and y repeated behind (ωx ωy ωz ωx ωy), so the rotated

@@ -15,18 +15,14 @@ Three named steps, in this order (softstep.frame runs them):
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from . import energy_guard, exact, penetration
 from .model import Model
 from .resting import WarmStart
 from .settings import MAX_PUSH, PENETRATION_TOLERANCE, SEPARATE_REACH, SEPARATE_SWEEPS, SLOP, SLOP_RETURN
+from .soft_frame import SoftFrame
 from .state import State, X, with_static
-
-if TYPE_CHECKING:
-    from .softstep import SoftFrame
 
 
 def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import dataclass
 
 # --- The step -------------------------------------------------------------------------------------
 
@@ -253,3 +254,15 @@ TIME_TO_SLEEP = 0.5
 
 # Balls RK4's fast path takes at a time: its scratch columns then stay in the cache.
 RK4_CHUNK = 8192
+
+# --- The energy guards (energy_guard.py) ----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class EnergyGuards:
+    """Which energy guards are on (energy_guard.py: its rule, and what each keeps): all of them, unless
+    a test switches one off to show what it prevents (``Model.guards``)."""
+
+    impulses: bool = True
+    lift: bool = True
+    frame: bool = True
