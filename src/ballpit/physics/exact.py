@@ -56,6 +56,8 @@ def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         a = np.asarray(a, float)
     if not (type(b) is np.ndarray and b.dtype == np.float64):
         b = np.asarray(b, float)
+    if a.shape[-1] == 3 == b.shape[-1]:  # the common case, the same sums written out
+        return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
     out = a[..., 0] * b[..., 0]
     for k in range(1, max(a.shape[-1], b.shape[-1])):
         out = out + a[..., k] * b[..., k]
@@ -127,6 +129,12 @@ def cross_rows(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     np.subtract(p2 * q0, p0 * q2, out=out[..., 1])
     np.subtract(p0 * q1, p1 * q0, out=out[..., 2])
     return out
+
+
+def norm_floats(x: float, y: float, z: float) -> float:
+    """|(x, y, z)| of one vector in Python floats, its squares summed first to last (a plane's speed or
+    spin: a few a step, where NumPy's calls would cost more than the arithmetic)."""
+    return math.sqrt((x * x + y * y) + z * z)
 
 
 def dot_cols(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -49,7 +49,7 @@ def advance(model: Model, state: State, h: float) -> None:
         (cx, cy, cz), (vx, vy, vz) = center[i].tolist(), velocity[i].tolist()
         center[i] = (cx + vx * h, cy + vy * h, cz + vz * h)
         wx, wy, wz = spin[i].tolist()
-        rate = math.sqrt((wx * wx + wy * wy) + wz * wz)  # as np.linalg.norm sums a row
+        rate = exact.norm_floats(wx, wy, wz)  # as np.linalg.norm sums a row
         if rate > 0.0:
             px, py, pz, pw = _turn(wx, wy, wz, rate, h)
             qx, qy, qz, qw = orientation[i].tolist()
@@ -96,7 +96,7 @@ def _store_orientation(pose: Columns, i: int, q: tuple[float, float, float, floa
         )
 
     nx, ny, nz = rotate(0.0, 1.0, 0.0)
-    size = math.sqrt((nx * nx + ny * ny) + nz * nz)
+    size = exact.norm_floats(nx, ny, nz)
     pose.full("orientation")[i] = q
     pose.full("axis_u")[i] = rotate(1.0, 0.0, 0.0)
     pose.full("normal")[i] = (nx / size, ny / size, nz / size)
@@ -125,8 +125,8 @@ def sweep(model: Model, plane: int, h: float, distance: np.ndarray) -> np.ndarra
     """How far a point of ``plane`` within ``distance`` of its centre can move in ``h``:
     |v|·h + |ω|·h·(d + |v|·h) (an arc is never longer than its angle times its radius)."""
     pl = model.planes
-    shift = float(exact.norm_rows(pl.velocity[plane])) * h
-    return shift + float(exact.norm_rows(model.plane_spin()[plane])) * h * (distance + shift)
+    shift = exact.norm_floats(*pl.velocity[plane].tolist()) * h
+    return shift + exact.norm_floats(*model.plane_spin()[plane].tolist()) * h * (distance + shift)
 
 
 def closing_speed_bound(
