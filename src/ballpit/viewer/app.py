@@ -72,6 +72,7 @@ class Viewer:
         from .renderer import Renderer
         from .screen import ScreenOverlay
         from .stepper import PhysicsThread
+        from .video import VideoRecorder
 
         if world is None:
             from ballpit.scene import read_scene
@@ -102,6 +103,7 @@ class Viewer:
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
         self.screen = ScreenOverlay(self.window, self.physics)
+        self.video = VideoRecorder(self.window, lambda message: self.hud.flash(message, time.perf_counter()))
         self._interaction_seconds: deque[float] = deque()
         self._interaction_input: tuple = ()
         self._interaction_queued = False
@@ -240,6 +242,8 @@ class Viewer:
             self.camera.look_from(look.camera_position, look.camera_look_at)
         elif action is Action.SAVE:
             self.save_scene()
+        elif action is Action.RECORD_VIDEO:
+            self.video.toggle()
         self._hud_at = 0.0  # refresh the HUD on the next frame
         self.physics.refresh_hud()
 
@@ -318,7 +322,8 @@ class Viewer:
     def finish_record(self) -> None:
         """Write the ``--record`` file (once), when the window closes or the run is interrupted: the
         steps finished by then, up to the one shown (a step still in progress on the physics thread, or
-        taken ahead of what the window shows, is left out)."""
+        taken ahead of what the window shows, is left out). A video being recorded is finished too."""
+        self.video.stop()
         if self.recorder is not None and not self.recorder.finished:
             shown, sim = self.physics.shown, self.sim
             ahead = sim.phase is Phase.RUNNING and shown.generation == sim.generation  # may have run ahead
@@ -451,6 +456,7 @@ class Viewer:
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
+        self.video.frame(shown.time, shown.hud is None or shown.hud.running, width, height)
         self._count_frame(now, shown)
 
     def _view_key(self, shown: Shown, width: int, height: int) -> tuple | None:

@@ -49,6 +49,7 @@ class Action(Enum):
     SHOT_SPEED = "change the shot speed"
     HOME = "camera back to the scene's view"
     SAVE = "save the scene as it stands to a new file"
+    RECORD_VIDEO = "record the window to MP4 / stop"
 
 
 KEY_ACTIONS: dict[str, Action] = {
@@ -68,6 +69,7 @@ KEY_ACTIONS: dict[str, Action] = {
     "F2": Action.PROFILE,
     "F3": Action.QUALITY,
     "F12": Action.SCREENSHOT,
+    "F9": Action.RECORD_VIDEO,
     "LEFT": Action.STEP_BACK,
     "G": Action.GHOSTS,
     "P": Action.ENERGY_PLOT,
@@ -141,6 +143,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("C / V / T, P", "contacts, velocities, trails; energy plot"),
     ("H / F1 / F2 / F3", "HUD / this help / time per stage / quality"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
+    ("F9", "record MP4 into videos/ (F9 again stops)"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),
     ("B / Shift+B", "shoot a ball along the view / its speed"),
     ("click a plane", "select it: arrows tilt it, PgUp/PgDn lift it"),
