@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 import queue
 import threading
+import time
 from fractions import Fraction
 from pathlib import Path
 
@@ -63,6 +64,7 @@ class Mp4Writer:
         self.size = (width, height)
         self.fps = fps
         self.frames = 0  # frames queued so far
+        self.wait_seconds = 0.0  # wall s ``write`` waited for the encoder (its queue full)
         remove_stale_temps(self.path)
         self._temp = temp_path(self.path)
         self._container = av.open(str(self._temp), "w", format="mp4", options={"movflags": "+faststart"})
@@ -113,10 +115,18 @@ class Mp4Writer:
             if not self._thread.is_alive():
                 return
             try:
+                self._queue.put_nowait(item)
+                return
+            except queue.Full:
+                pass
+            started = time.perf_counter()
+            try:
                 self._queue.put(item, timeout=0.1)
                 return
             except queue.Full:
                 continue
+            finally:
+                self.wait_seconds += time.perf_counter() - started
 
     def close(self) -> Path:
         """Encode what is queued, finish the file and move it into place; returns its path."""
