@@ -303,3 +303,29 @@ def test_balls_touching_the_back_of_an_opaque_wall_never_show_through_it(offscre
         balls = screen.render(scene(True), camera).astype(int)
     leaks = int((np.abs(balls - wall).max(axis=-1) > 2).sum())
     assert leaks == 0
+
+
+def test_a_slope_tilted_over_keeps_its_colour_on_its_back(offscreen):
+    """A slope (a finite plane facing up as the scene starts) is solid: tilted until its back faces the
+    camera it is drawn opaque in its own colour, lit as a face of its own, not as a faint wall."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    world.add_plane(position=(0, 1.5, 0), rotation=(0, 0, 10), size=2.0, restitution=1.0)  # orange
+    sim = Simulation(world)
+    camera = Camera.looking_at((0.0, 4.0, -6.0), (0.0, 1.5, 0.0))
+    front = offscreen.render(sim, camera).astype(int)
+    (cx, cy), _ = camera.project(np.array([0.0, 1.5, 0.0]), 200, 150)
+    center = (int(cy), int(cx))
+    assert front[center][0] > front[center][2] + 60  # orange, from the front
+    slope = world.planes[1]
+    slope.angular_velocity = (math.radians(120), 0.0, 0.0)  # tipped over towards +z, away from the camera
+    for _ in range(240):
+        world.step(1 / 240)
+    slope.angular_velocity = (0.0, 0.0, 0.0)
+    eye = np.asarray(camera.position, float)
+    assert np.dot(eye - slope.position, slope.normal) < 0  # the camera sees its back now
+    back = offscreen.render(sim, camera).astype(int)
+    assert "solid plane backs" in [c.label for c in offscreen.renderer.draws.calls]
+    pixel = back[center]
+    assert np.abs(pixel - background_pixel()).max() > 40  # not a faint tint over the background
+    assert pixel[0] > pixel[2] + 30 and pixel[0] > pixel[1]  # still orange (in the shade: darker)
