@@ -248,8 +248,8 @@ class Viewer:
         self.physics.refresh_hud()
 
     def escape(self) -> None:
-        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
-        until then the HUD asks for it."""
+        """Esc: release a captured mouse (and nothing else), else quit only on a second Esc within a
+        couple of seconds; until then the HUD asks for it."""
         now = time.perf_counter()
         if not self.mouse_captured and self.interaction.selected_plane is not None:
             self.command(lambda sim: self.interaction.deselect())
@@ -261,6 +261,8 @@ class Viewer:
             return
         if outcome == "release":
             self.capture_mouse(False)
+            self.hud.flash(controls.RELEASED_HINT, now)
+            return
         self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
         self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 

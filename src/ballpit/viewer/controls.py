@@ -126,6 +126,7 @@ FLY_SPEED_RANGE = (0.05, 500.0)
 # A second Esc within this many seconds quits; the HUD asks for it as long.
 QUIT_CONFIRM_SECONDS = 2.0
 QUIT_HINT = "press Esc again to quit"
+RELEASED_HINT = "mouse released (Tab captures it again)"
 
 # Time scale (simulated seconds per real second) steps by a factor of 2 within these bounds.
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
@@ -199,7 +200,7 @@ def slower(scale: float) -> float:
 def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
     """What Esc does: release a captured mouse ("release"); with nothing captured, quit only if Esc was
     pressed in the last ``QUIT_CONFIRM_SECONDS`` (``armed``: "quit"), else ask for a second Esc ("arm").
-    Releasing the mouse arms the quit too: Esc releases it, Esc again quits."""
+    Releasing the mouse does nothing else: quitting still takes Esc, Esc after it."""
     if mouse_captured:
         return "release"
     return "quit" if armed else "arm"

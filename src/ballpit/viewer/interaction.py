@@ -90,7 +90,8 @@ class Interaction:
             return ""
         if hit.kind == "plane":
             self.select(hit.index)
-            return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+            # numbered as world.planes and the events' b (plane index) count them: from 0
+            return f"plane {hit.index} selected: arrows tilt it, PgUp/PgDn raise and lower it"
         if self.in_replay:
             return NOT_IN_REPLAY.format("dragging a ball")
         ball = self.sim.world.spheres[hit.index]
@@ -257,5 +258,5 @@ class Interaction:
             speed = float(np.linalg.norm(self.throw_velocity()))
             lines.append(f"holding     ball {self.held_ball}, throw {speed:.2f} m/s")
         if self.selected_plane is not None:
-            lines.append(f"selected    plane #{self.selected_plane + 1}: arrows PgUp PgDn")
+            lines.append(f"selected    plane {self.selected_plane}: arrows PgUp PgDn")
         return lines
