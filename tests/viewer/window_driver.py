@@ -277,9 +277,12 @@ def keys(workdir: Path) -> dict:
     press(viewer, "TAB")
     out["captured"] = viewer.mouse_captured
     press(viewer, "ESCAPE")
-    out["after_first_escape"] = {"captured": viewer.mouse_captured, "closed": viewer.closed}
+    out["after_first_escape"] = {"captured": viewer.mouse_captured, "closed": viewer.closed,
+                                 "message": shown_message(viewer)}  # fmt: skip
+    press(viewer, "ESCAPE")  # the Esc that released the mouse did not arm the quit: this one asks
+    out["after_second_escape"] = {"closed": viewer.closed, "message": shown_message(viewer)}
     press(viewer, "ESCAPE")
-    out["after_second_escape"] = {"closed": viewer.closed}
+    out["after_third_escape"] = {"closed": viewer.closed}
     return out
 
 

@@ -64,9 +64,10 @@ class FrameFeeder:
         self.renderer.upload_balls(positions, shown.orientations, shown.radii, shown.sphere_colors, eye)
         self._upload_ghosts(shown)
 
-        world_lines, overlay_lines = overlays.empty(), overlays.empty()
+        trails, overlay_lines = overlays.empty(), overlays.empty()
         if flags.trails and shown.trails is not None and shown.trails.shape[1] == len(positions):
-            world_lines = overlays.trail_lines(shown.trails, shown.sphere_colors, positions)
+            eye = shown.plane_centers.mean(axis=0) + (0, 1e3, 0) if eye is None else eye  # no eye: from above
+            trails = overlays.trail_ribbons(shown.trails, shown.sphere_colors, shown.radii, eye, positions)
         parts = []
         if flags.contacts and shown.contact_points is not None:
             parts.append(overlays.contact_lines(shown.contact_points, shown.contact_normals))
@@ -76,7 +77,7 @@ class FrameFeeder:
             parts.append(extra_lines)
         if parts:
             overlay_lines = np.concatenate(parts)
-        self.renderer.upload_lines(world_lines, overlay_lines)
+        self.renderer.upload_lines(trails, overlay_lines)
         self.upload_seconds = time.perf_counter() - started
 
     def _upload_ghosts(self, shown: Shown) -> None:

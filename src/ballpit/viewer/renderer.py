@@ -196,9 +196,9 @@ class Renderer:
         self.plane_program.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
         GL.glUseProgram(0)
 
-        # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
+        # trails (a triangle strip, depth tested) then overlay lines (always on top), in one buffer
         self.line_vao, self.line_vbo = _vertex_array()
-        self.world_line_vertices = 0
+        self.trail_vertices = 0
         self.overlay_line_vertices = 0
 
         # screen-space overlays in window pixels (timeline bar, energy plot): triangles, then lines
@@ -329,10 +329,11 @@ class Renderer:
             GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
 
-    def upload_lines(self, world_lines: np.ndarray, overlay_lines: np.ndarray) -> None:
-        """Line vertices (M, 7) for this frame: depth-tested world lines, then always-visible overlays."""
-        data = np.concatenate([world_lines, overlay_lines]).astype(np.float32, copy=False)
-        self.world_line_vertices = len(world_lines)
+    def upload_lines(self, trails: np.ndarray, overlay_lines: np.ndarray) -> None:
+        """Vertices (M, 7) for this frame: the trails' triangle strip (depth-tested; overlays.py), then
+        the always-visible overlay lines."""
+        data = np.concatenate([trails, overlay_lines]).astype(np.float32, copy=False)
+        self.trail_vertices = len(trails)
         self.overlay_line_vertices = len(overlay_lines)
         if len(data):
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.line_vbo)
@@ -447,19 +448,19 @@ class Renderer:
         if (behind & ~self._plane_solid).any():  # back faces, see-through
             self._back_faces("see-through planes", False, view_projection, eye)
 
-        if self.world_line_vertices or self.overlay_line_vertices:
+        if self.trail_vertices or self.overlay_line_vertices:
             self.line_program.use()
             self.line_program.set("u_view_projection", view_projection)
             GL.glEnable(GL.GL_BLEND)
             GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
             GL.glDepthMask(GL.GL_FALSE)
             GL.glBindVertexArray(self.line_vao)
-            if self.world_line_vertices:
-                self.draws.arrays("world lines", GL.GL_LINES, 0, self.world_line_vertices)
+            if self.trail_vertices:
+                self.draws.arrays("trails", GL.GL_TRIANGLE_STRIP, 0, self.trail_vertices)
             if self.overlay_line_vertices:
                 GL.glDisable(GL.GL_DEPTH_TEST)
                 self.draws.arrays(
-                    "overlay lines", GL.GL_LINES, self.world_line_vertices, self.overlay_line_vertices
+                    "overlay lines", GL.GL_LINES, self.trail_vertices, self.overlay_line_vertices
                 )
             GL.glDepthMask(GL.GL_TRUE)
 
