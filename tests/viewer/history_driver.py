@@ -19,6 +19,7 @@ import window_driver as wd
 
 import ballpit
 from ballpit.physics import INTEGRATOR_NAMES
+from ballpit.viewer.energyplot import KINETIC_COLOR
 from ballpit.viewer.ghosts import TINTS
 from ballpit.viewer.screen import plot_rect, timeline_bar
 
@@ -158,8 +159,8 @@ def ghosts_and_plot(workdir: Path) -> dict:
     out["plot_pixels"] = {
         name: int((np.abs(region - np.array(c)).max(axis=-1) < 40).sum()) for name, c in tints.items()
     }
-    green = (region[..., 1] > 180) & (region[..., 0] < 150) & (region[..., 2] < 150)
-    out["kinetic_pixels"] = int(green.sum())
+    kinetic = np.array([round(255 * c) for c in KINETIC_COLOR[:3]])
+    out["kinetic_pixels"] = int((np.abs(region - kinetic).max(axis=-1) < 40).sum())
     series = sim.timeline.energy.series()
     out["series"] = sorted(series)
     out["span"] = float(series["time"][-1] - series["time"][0])

@@ -279,7 +279,8 @@ class Viewer:
         self.command(lambda sim: (sim.reload(), sim.error)[1], self.hud.set_error)
 
     def save_scene(self) -> None:
-        """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
+        """Ctrl+S: write the scene as it stands to a new file beside the original (a bundled scene: in
+        the current directory, save.py); the HUD says where."""
         camera = copy.deepcopy(self.camera)
 
         def save(sim: Simulation) -> Path | OSError:

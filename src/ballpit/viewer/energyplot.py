@@ -15,8 +15,10 @@ from .ghosts import LABELS, TINTS
 from .overlays import VERTEX_WIDTH
 
 WINDOW_SECONDS = 10.0
-KINETIC_COLOR = (0.45, 0.95, 0.45, 1.0)
-POTENTIAL_COLOR = (0.45, 0.6, 1.0, 1.0)
+# Kinetic and potential energy: pink and violet, apart from every integrator's colour (red, orange,
+# blue, green: physics/integrators.py), which the totals take with ghosts on.
+KINETIC_COLOR = (1.0, 0.45, 0.8, 1.0)
+POTENTIAL_COLOR = (0.69, 0.55, 1.0, 1.0)
 TOTAL_COLOR = (0.97, 0.97, 0.97, 1.0)
 PANEL_COLOR = (0.04, 0.05, 0.07, 0.75)
 FRAME_COLOR = (0.6, 0.63, 0.7, 0.8)
@@ -75,8 +77,8 @@ def _polyline(x: np.ndarray, y: np.ndarray, color: tuple) -> np.ndarray:
 
 
 def curve_colors(series: dict[str, np.ndarray], ghosts: bool) -> dict[str, tuple]:
-    """The colour of each curve: K green, U blue, the total white (one per integrator, tinted, with
-    ghosts on)."""
+    """The colour of each curve: K pink, U violet, the total white (one per integrator, in its colour,
+    with ghosts on)."""
     colors = {"kinetic": KINETIC_COLOR, "potential": POTENTIAL_COLOR}
     for key in series:
         if key.startswith("total "):
@@ -97,6 +99,24 @@ def legend(series: dict[str, np.ndarray], ghosts: bool) -> list[tuple[str, tuple
             name = key[len("total ") :]
             items.append((f"E {LABELS[name]}" if ghosts else "total", color))
     return items
+
+
+def legend_layout(
+    widths: list[float], rect: tuple[float, float, float, float], line_height: float, gap: float = 12.0,
+    pad: float = 6.0,
+) -> list[tuple[float, float]]:  # fmt: skip
+    """Where each legend label of these ``widths`` goes (x, y of its bottom-left corner, window pixels,
+    y up): along the bottom of the plot in ``rect``, one after another, a new row above when the next
+    would pass the plot's right edge, so every label stays inside it."""
+    x0, y0, w, _ = rect
+    right = x0 + w - pad
+    places, x, y = [], x0 + pad, y0 + 4.0
+    for width in widths:
+        if x > x0 + pad and x + width > right:
+            x, y = x0 + pad, y + line_height
+        places.append((x, y))
+        x += width + gap
+    return places
 
 
 def plot_shapes(

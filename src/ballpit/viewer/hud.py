@@ -17,7 +17,9 @@ from .handover import HudFacts
 from .simulation import Simulation
 
 FONT = ("DejaVu Sans Mono", "Menlo", "Consolas", "Courier New", "monospace")
-FONT_SIZE = 11
+FONT_SIZE = 11  # points in a window of REFERENCE_SIZE; the HUD's text scales with the window (font_size)
+REFERENCE_SIZE = (1280, 720)
+FONT_SIZE_RANGE = (7.0, 22.0)  # points: still readable when small, not a poster when huge
 TEXT_COLOR = (235, 238, 245, 255)
 ERROR_COLOR = (255, 110, 100, 255)
 PANEL_COLOR = (10, 12, 18, 190)
@@ -65,10 +67,24 @@ def profile_lines(sim: Simulation | HudFacts, drawn: Sequence[str] = ()) -> list
     return [f"{f.name}: step profile, {f.profile[0]}", *f.profile[1:], *drawn, "F2 back  H hide"]
 
 
+def font_size(width: int, height: int) -> float:
+    """The HUD's font size (points) in a ``width`` x ``height`` window: FONT_SIZE at REFERENCE_SIZE,
+    scaled by the side that shrank most (so the HUD keeps its share of the window), within
+    FONT_SIZE_RANGE, in half points (each size is laid out once, not at every pixel of a drag)."""
+    scale = min(width / REFERENCE_SIZE[0], height / REFERENCE_SIZE[1])
+    low, high = FONT_SIZE_RANGE
+    return min(max(round(2.0 * FONT_SIZE * scale) / 2.0, low), high)
+
+
+# What a finite plane's colour says (scene/colours.py's ramp): its restitution, at the ramp's three
+# stops. Most scenes' planes lie between them (the demo's slopes 0.55-0.95: green to orange).
+PLANE_LEGEND = "plane colour = restitution: 0 slate blue, 0.5 green, 1 orange"
+
+
 def help_text() -> str:
     width = max(len(keys) for keys, _ in HELP)
     rows = [f"{keys:<{width}}  {what}" for keys, what in HELP]
-    return "\n".join(["ballpit controls", "", *rows, "", "plane colour: blue dead → green → orange bouncy"])
+    return "\n".join(["ballpit controls", "", *rows, "", PLANE_LEGEND])
 
 
 class Hud:
@@ -110,8 +126,15 @@ class Hud:
         self.layout()
 
     def layout(self) -> None:
-        """Place the labels for the window's current size."""
+        """Place the labels for the window's current size, their text scaled to it (``font_size``)."""
         w, h = self.window.width, self.window.height
+        size = font_size(w, h)
+        for label in (self.label, self.error_label, self.message_label, self.help_label):
+            if label.font_size != size:
+                label.font_size = size
+        if self.help_label.width != self.help_label.content_width + 2:
+            self.help_label.width = self.help_label.content_width + 2
+            self._help_layout_key = ()
         self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
         self.error_label.width = max(w - 2 * MARGIN, 100)
         self.error_label.x, self.error_label.y = MARGIN, MARGIN + self.bottom

@@ -13,7 +13,7 @@ import numpy as np
 import pyglet
 
 from .energyplot import legend as plot_legend
-from .energyplot import plot_shapes
+from .energyplot import legend_layout, plot_shapes
 from .hud import FONT, TEXT_COLOR
 from .overlays import VERTEX_WIDTH
 from .stepper import PhysicsThread
@@ -158,16 +158,15 @@ class ScreenOverlay:
             self.plot_labels.append(pyglet.text.Label(
                 "", font_name=FONT, font_size=FONT_SIZE, anchor_y="bottom", batch=self.plot_batch
             ))  # fmt: skip
-        cx = x + 6
-        for index, (label, (text, color, lx, ly)) in enumerate(zip(self.plot_labels, texts, strict=False)):
+        for label, (text, color, lx, ly) in zip(self.plot_labels, texts, strict=False):
             if label.text != text:
                 label.text = text
-            label.color, label.y = color, ly
-            if index == 0:
-                label.x = lx
-            else:  # the legend, one after another along the bottom of the plot
-                label.x = cx
-                cx += label.content_width + 12
+            label.color, label.x, label.y = color, lx, ly
+        legend = self.plot_labels[1 : len(texts)]  # along the bottom of the plot, in rows that fit it
+        places = legend_layout([lb.content_width for lb in legend], rect, legend[0].content_height if legend
+                               else 0.0)  # fmt: skip
+        for label, (lx, ly) in zip(legend, places, strict=True):
+            label.x, label.y = lx, ly
         for label in self.plot_labels[len(texts) :]:
             label.text = ""
 
