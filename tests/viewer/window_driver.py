@@ -351,7 +351,7 @@ def panel_rectangle(viewer: Viewer, panel: object) -> list[float]:
 def help_beside_hud(workdir: Path) -> dict:
     """F1 in windows of several sizes, with the HUD shown: where the two panels are drawn."""
     out: dict = {}
-    for size in ((1280, 720), (900, 700), (700, 420)):
+    for size in ((1280, 720), (900, 700), (700, 420), (600, 300)):
         viewer = open_viewer(size=size, world=balls_world())
         pump(viewer, 2)
         press(viewer, "F1", frames=2)

@@ -78,7 +78,7 @@ def font_size(width: int, height: int) -> float:
 
 # What a finite plane's colour says (scene/colours.py's ramp): its restitution, at the ramp's three
 # stops. Most scenes' planes lie between them (the demo's slopes 0.55-0.95: green to orange).
-PLANE_LEGEND = "plane colour = restitution: 0 slate blue, 0.5 green, 1 orange"
+PLANE_LEGEND = "plane colour = restitution: 0 slate blue (dead), 0.5 green, 1 orange (bouncy)"
 
 
 def help_text() -> str:
