@@ -11,10 +11,11 @@
 // The balls shade the opaque faces: each one near the ray towards the sun casts a soft-edged shadow,
 // and each one close by hides part of the sky (contact darkening). The renderer bins the balls in a
 // grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only its own cell. The
-// solid finite planes cast soft-edged shadows too (``plane_shadow``), so the ground under a slope is in
-// its shade, and a ball's shadow falls on the first thing below it, not through the slope as well.
+// solid finite planes cast soft-edged shadows too (casters.glsl), so the ground under a slope is in its
+// shade, and a ball's shadow falls on the first thing below it, not through the slope as well.
 
 #include "common.glsl"
+#include "casters.glsl"
 
 in vec3 v_world;
 in vec2 v_local;
@@ -31,16 +32,6 @@ uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, 
 uniform vec2 u_shadow_shape;            // cells along u and v; (0, 0): no shadows
 uniform float u_shadow_reach;           // ball radii from the centre where a ball's shading ends
 uniform float u_back_pass;              // back faces drawn now: 1 the solid ones, 0 the see-through ones
-
-// the planes that cast shadows (solid and finite): centre, unit axes, half sizes, normal, index
-const int MAX_CASTERS = 16;
-uniform int u_caster_count;
-uniform vec3 u_caster_center[MAX_CASTERS];
-uniform vec3 u_caster_u[MAX_CASTERS];
-uniform vec3 u_caster_v[MAX_CASTERS];
-uniform vec2 u_caster_half[MAX_CASTERS];
-uniform vec3 u_caster_normal[MAX_CASTERS];
-uniform int u_caster_index[MAX_CASTERS];
 
 out vec4 frag_color;
 
@@ -63,7 +54,6 @@ float grid(vec2 p, float spacing, float width_pixels) {
     return on * (1.0 - smoothstep(0.15, 0.5, density));
 }
 
-const float SUN_RADIUS = 0.035;        // radians: a disc a little wider than the real sun, soft edges
 
 // The balls near this point's ray towards the sun: the fraction of the sun it sees (x) and the
 // fraction of the ambient light the close ones leave (y). Its cell holds every ball that can shade it.
@@ -96,25 +86,6 @@ vec2 ball_shading(vec3 p, vec3 n, vec2 g) {
     return vec2(sun, ambient);
 }
 
-// The fraction of the sun point p sees past the casting planes: where the ray towards the sun crosses
-// one inside its rectangle, none; the edge is soft over the sun's angular radius, as a ball's is.
-float plane_shadow(vec3 p) {
-    float sun = 1.0;
-    for (int i = 0; i < u_caster_count; ++i) {
-        if (u_caster_index[i] == v_index) continue;
-        vec3 normal = u_caster_normal[i];
-        float facing = dot(u_sun_direction, normal);
-        if (abs(facing) < 1e-4) continue;  // edge on to the sun: no shadow to speak of
-        float t = dot(u_caster_center[i] - p, normal) / facing;
-        if (t <= 1e-3) continue;  // the plane is not between p and the sun
-        vec3 q = p + t * u_sun_direction - u_caster_center[i];
-        vec2 outside = abs(vec2(dot(q, u_caster_u[i]), dot(q, u_caster_v[i]))) - u_caster_half[i];
-        float w = t * SUN_RADIUS + 1e-3;
-        sun = min(sun, smoothstep(-w, w, max(outside.x, outside.y)));
-    }
-    return sun;
-}
-
 void main() {
     bool back = !gl_FrontFacing;
     if (back && (v_solid > 0.5) != (u_back_pass > 0.5)) discard;  // drawn in the other back pass
@@ -142,7 +113,7 @@ void main() {
     }
 
     vec2 shading = see_through ? vec2(1.0) : ball_shading(v_world, n, v_shadow_grid);
-    if (!see_through && dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, plane_shadow(v_world));
+    if (!see_through && dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, plane_shadow(v_world, v_index));
     vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

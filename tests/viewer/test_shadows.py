@@ -272,3 +272,28 @@ def test_the_sun_grid_stays_bounded():
     assert grid.ranges.shape == (grid.cells, 2) and grid.ranges[-1, 1] == len(grid.balls)
     assert np.all(np.diff(grid.ranges, axis=1) <= shadows.LIMIT)
     assert np.all(grid.ranges[1:, 0] == grid.ranges[:-1, 1])
+
+
+def test_a_ball_under_a_slope_is_in_its_shade(offscreen):
+    def scene(slope: bool) -> Simulation:
+        world = ballpit.World(gravity=(0, 0, 0))
+        world.add_plane(position=(0, 0, 0))
+        if slope:
+            world.add_plane(position=(0, 1.5, 0), size=3.0)  # its shadow covers the ball (below)
+        world.add_sphere(position=(0.0, 0.3, 0.0), radius=0.3)
+        return Simulation(world)
+
+    camera = Camera.looking_at((0.0, 0.6, 4.0), (0.0, 0.3, 0.0))  # under the slope's level
+    assert crosses_slope_at((0.0, 0.3, 0.0), height=1.5, half=1.5)
+    ball = sphere_mask(camera, (0.0, 0.3, 0.0), 0.3 * 0.9)  # inside the rim
+    lit = brightness(offscreen.render(scene(False), camera))[ball].mean()
+    shaded = brightness(offscreen.render(scene(True), camera))[ball].mean()
+    assert shaded < 0.75 * lit
+
+
+def crosses_slope_at(point, height: float, half: float) -> bool:
+    """Whether the ray from ``point`` towards the sun crosses the level square of half size ``half``
+    centred above the origin at ``height``."""
+    point = np.asarray(point, float)
+    hit = point + SUN * (height - point[1]) / SUN[1]
+    return bool(abs(hit[0]) < half and abs(hit[2]) < half)

@@ -16,8 +16,8 @@ The back passes are skipped when the eye is on the front side of every plane the
 The balls cast shadows onto the planes' opaque faces and darken them where they touch (see
 shadows.py): each frame the balls are binned in a grid seen from the sun, uploaded as two texture
 buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call. The solid
-planes cast shadows on the others (at most ``MAX_CASTERS``, passed as uniforms), so a ball's shadow
-ends at the first plane under it.
+planes cast shadows on the other planes and on the balls (at most ``MAX_CASTERS``, passed as uniforms:
+casters.glsl), so a ball's shadow ends at the first plane under it.
 """
 
 from __future__ import annotations
@@ -360,6 +360,10 @@ class Renderer:
         program.set("u_shadow_inverse_cell", 1.0 / grid.cell_size)
         program.set("u_shadow_shape", np.array(grid.shape, dtype=np.float32))
         program.set("u_shadow_reach", shadows.REACH)
+        self._caster_uniforms(program)
+
+    def _caster_uniforms(self, program: Program) -> None:
+        """The solid planes that cast shadows (casters.glsl), for the plane or the ball shader."""
         casts = self._caster_index if self.shadows else np.zeros(0, dtype=int)
         program.set_int("u_caster_count", len(casts))
         if len(casts):
@@ -424,6 +428,7 @@ class Renderer:
 
         if self.ball_count:
             self._common_uniforms(self.ball_program, view_projection, eye)
+            self._caster_uniforms(self.ball_program)
             self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
             self.ball_program.set("u_alpha", 1.0)
             if multisample:
@@ -435,6 +440,7 @@ class Renderer:
 
         if self.ghost_count:  # translucent ghosts: blended, not writing depth
             self._common_uniforms(self.ball_program, view_projection, eye)
+            self._caster_uniforms(self.ball_program)
             self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
             self.ball_program.set("u_alpha", self.ghost_alpha)
             GL.glEnable(GL.GL_BLEND)
