@@ -40,13 +40,3 @@ def test_the_hud_keeps_its_share_of_a_small_window(xvfb, tmp_path):
     share_big, share_small = big["height"] / 720, small["height"] / 450
     assert share_small <= 1.15 * share_big  # it was 1.6 times the share: 11 points in a smaller window
     assert small["width"] / 800 <= 1.15 * big["width"] / 1280
-
-
-def test_the_energy_plots_legend_stays_inside_the_plot(xvfb, tmp_path):
-    r = run_scenario(xvfb, "legend_in_plot", tmp_path)
-    x, y, w, h = r["rect"]
-    texts = [item[0] for item in r["legend"]]
-    assert texts[:2] == ["kinetic", "potential"] and "E Symplectic" in texts and len(texts) == 6
-    for text, lx, ly, width, height in r["legend"]:
-        assert x <= lx and lx + width <= x + w <= r["window"][0], text
-        assert y <= ly and ly + height <= y + h, text
