@@ -177,3 +177,14 @@ def test_ctrl_c_during_an_mp4_render_leaves_no_file(tmp_path):
     assert proc.returncode == 130, stderr
     assert stderr.strip().splitlines()[-1] == "ballpit: interrupted"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_window_video_takes_the_3d_view_right_of_the_panel_round_its_centre():
+    from ballpit.viewer.video import view_crop
+
+    # the panel (330 px) shown: the 950 px right of it, the whole frame
+    assert view_crop(1280, 720, 330, (950, 720)) == ((330, 0, 950, 720), (0, 0))
+    # hidden while recording: the view widens to 1280 px about the same middle; its middle 950 are kept
+    assert view_crop(1280, 720, 0, (950, 720)) == ((165, 0, 950, 720), (0, 0))
+    # the window shrunk to 800x450: all of its view, centred in the frame (black round it)
+    assert view_crop(800, 450, 330, (950, 720)) == ((330, 0, 470, 450), (240, 135))

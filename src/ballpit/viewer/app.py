@@ -118,7 +118,8 @@ class Viewer:
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
         self.screen = ScreenOverlay(self.window, self.physics)
-        self.video = VideoRecorder(self.window, lambda message: self.hud.flash(message, time.perf_counter()))
+        flash = lambda message: self.hud.flash(message, time.perf_counter())  # noqa: E731
+        self.video = VideoRecorder(self.window, flash, left=lambda: self.panel.width)  # right of the panel
         self._interaction_seconds: deque[float] = deque()
         self._interaction_input: tuple = ()
         self._interaction_queued = False

@@ -1,16 +1,23 @@
 """Recording the window to MP4 (F9, or the panel's button): one frame per 1/fps of simulated time.
 
 ``FrameClock`` decides, from the simulated time of the state each window frame shows, how many video
-frames that picture stands for; ``VideoRecorder`` reads the window's pixels (3-D view and HUD, what the
-user sees) when it stands for one or more and hands them to the MP4 writer (mp4.py), whose encoder
-runs on a thread of its own. So the video plays at the physics' real speed however fast the window
-draws: a window drawing 60 frames a second gives every other picture to a 30 fps video, and one
-drawing 20 holds some pictures for two video frames (the motion is as fast, only less smooth).
+frames that picture stands for; ``VideoRecorder`` reads the window's pixels when it stands for one or
+more and hands them to the MP4 writer (mp4.py), whose encoder runs on a thread of its own. So the video
+plays at the physics' real speed however fast the window draws: a window drawing 60 frames a second
+gives every other picture to a 30 fps video, and one drawing 20 holds some pictures for two video
+frames (the motion is as fast, only less smooth).
 
 Time that does not run adds nothing: before X, while paused, and a step, a scrub or a jump while paused
 are cuts, not stills. Going back (R, stepping back, a reload) is a cut too. The time scale (+ / −) is
 simulated time too, so a run slowed to ×0.5 plays at its real speed in the video, twice as fast as it
 was shown. The files go to ``videos/`` in the current directory, named by the time they started.
+
+The video is the 3-D view with what is drawn over it (the HUD, the timeline bar), not the panel: the
+pixels are read once the frame is drawn, panel and all, but only from the part of the window right of
+the panel (``view_crop``). The panel is the recording user's tool; whoever watches the video wants the
+scene, as MuJoCo's recordings hold the scene and not its UI. So the video keeps its size and its
+framing when the panel is shown or hidden while it records (F4): the view is cut, or bordered in
+black, round its centre.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ VIDEO_FPS = 30
 SAME_TIME = 1e-9  # s: a state this close to a frame's time is on it (times are sums of steps)
 REC_FONT_SIZE = 12
 REC_COLOR = (255, 80, 70, 255)
+REC_MARGIN = 10  # px from the window's top-right corner to the "● REC" mark
 
 
 class FrameClock:
@@ -83,12 +91,17 @@ def video_path(directory: Path, now: datetime | None = None) -> Path:
 
 class VideoRecorder:
     """The video of one window: ``start``, ``stop``, ``toggle`` and ``is_recording`` (F9 and the panel's
-    button), and ``frame`` after every drawn frame. ``say`` shows a message (the HUD's)."""
+    button), and ``frame`` after every drawn frame. ``say`` shows a message (the HUD's); ``left`` gives
+    the window pixels at the left that the video leaves out (the panel's width: 0 while it is hidden)."""
 
     def __init__(
-        self, window: object, say: Callable[[str], None], fps: float = VIDEO_FPS,
+        self,
+        window: object,
+        say: Callable[[str], None],
+        fps: float = VIDEO_FPS,
         directory: Path | None = None,
-    ) -> None:  # fmt: skip
+        left: Callable[[], int] = lambda: 0,
+    ) -> None:
         import pyglet
 
         from .hud import FONT
@@ -101,14 +114,27 @@ class VideoRecorder:
         self.clock = FrameClock(fps)
         self.started_at: float | None = None  # simulated time of the first frame
         self.last_video: Finished | None = None
+        self.error: str | None = None  # why the last start or recording failed (the panel shows it)
+        self.left = left
         self.read_seconds = 0.0  # wall s spent reading pixels back (benchmarks read it)
         self.label = pyglet.text.Label(
-            "", font_name=FONT, font_size=REC_FONT_SIZE, color=REC_COLOR, anchor_x="center", anchor_y="top"
+            "", font_name=FONT, font_size=REC_FONT_SIZE, color=REC_COLOR, anchor_x="right", anchor_y="top"
         )
 
     @property
     def is_recording(self) -> bool:
         return self.writer is not None
+
+    @property
+    def seconds(self) -> float:
+        """Seconds of video recorded so far (0 when not recording)."""
+        return self.writer.duration if self.writer is not None else 0.0
+
+    def _left_pixels(self, width: int) -> int:
+        """The framebuffer columns the panel covers, in a framebuffer ``width`` wide (the window's
+        pixels scaled, on a display whose framebuffer is denser than its window coordinates)."""
+        scale = width / max(self.window.width, 1)  # type: ignore[attr-defined]
+        return min(max(round(self.left() * scale), 0), max(width - 2, 0))
 
     def toggle(self) -> None:
         if self.is_recording:
@@ -127,13 +153,15 @@ class VideoRecorder:
         directory = Path.cwd() / VIDEO_DIRECTORY if self.directory is None else self.directory
         try:
             directory.mkdir(parents=True, exist_ok=True)
-            size = even_size(*self.window.get_framebuffer_size())  # type: ignore[attr-defined]
+            width, height = self.window.get_framebuffer_size()  # type: ignore[attr-defined]
+            size = even_size(width - self._left_pixels(width), height)
             self.writer = Mp4Writer(video_path(directory), size, self.fps, kind="live")
         except (OSError, ValueError) as exc:
             self._say(f"cannot record video: {exc}", error=True)
             return None
         self.clock = FrameClock(self.fps)
         self.started_at = None
+        self.error = None
         self._say(f"recording video to {_short(self.writer.path)} (F9 stops)")
         return self.writer.path
 
@@ -171,7 +199,7 @@ class VideoRecorder:
             if self.started_at is None:
                 self.started_at = sim_time
             started = time.perf_counter()
-            image = read_back_buffer(width, height, self.writer.size)
+            image = read_back_buffer(width, height, self.writer.size, self._left_pixels(width))
             self.read_seconds += time.perf_counter() - started
             try:
                 self.writer.write(image, repeat=count)
@@ -181,13 +209,16 @@ class VideoRecorder:
                 self._say(f"video failed: {exc}", error=True)
                 return 0
         self.label.text = f"● REC {self.writer.duration:5.1f} s"
-        self.label.x, self.label.y = self.window.width // 2, self.window.height - 8  # type: ignore[attr-defined]
+        # the top-right corner: the HUD is at the top left, the help in the middle, the bar at the bottom
+        self.label.x = self.window.width - REC_MARGIN  # type: ignore[attr-defined]
+        self.label.y = self.window.height - REC_MARGIN  # type: ignore[attr-defined]
         self.label.draw()
         return count
 
     def _say(self, message: str, error: bool = False) -> None:
         """Show ``message`` in the window and print it (an error on stderr)."""
         if error:
+            self.error = message
             print(f"ballpit: {message}", file=sys.stderr, flush=True)
         else:
             print(message, flush=True)
@@ -199,16 +230,28 @@ def _short(path: Path) -> Path:
     return path.relative_to(Path.cwd()) if path.is_relative_to(Path.cwd()) else path
 
 
-def read_back_buffer(width: int, height: int, size: tuple[int, int]) -> np.ndarray:
-    """The back buffer's pixels as an (H, W, 3) RGB view, top row first, cropped or padded (black) to
-    ``size``: the window may have been resized since the video started."""
+def view_crop(
+    width: int, height: int, left: int, size: tuple[int, int]
+) -> tuple[tuple[int, int, int, int], tuple[int, int]]:
+    """Where a video frame of ``size`` comes from in a ``width`` x ``height`` back buffer whose ``left``
+    columns are the panel's: the rectangle (x, y, w, h; GL's rows, from the bottom) of at most ``size``
+    centred on the 3-D view right of the panel, and the (column, row from the top) of the frame it goes
+    to, centred too: a view smaller than the video (the panel shown, the window shrunk since the
+    video started) is bordered in black, a larger one cut, round the same centre."""
+    view = width - left
+    w, h = min(view, size[0]), min(height, size[1])
+    return (left + (view - w) // 2, (height - h) // 2, w, h), ((size[0] - w) // 2, (size[1] - h) // 2)
+
+
+def read_back_buffer(width: int, height: int, size: tuple[int, int], left: int = 0) -> np.ndarray:
+    """The back buffer's 3-D view (right of the ``left`` columns) as an (H, W, 3) RGB frame of ``size``,
+    top row first (``view_crop``)."""
     from OpenGL import GL
 
-    w, h = min(width, size[0]), min(height, size[1])
+    (x, y, w, h), (column, row) = view_crop(width, height, left, size)
     pixels = np.zeros((size[1], size[0], 3), dtype=np.uint8)
     GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
     GL.glReadBuffer(GL.GL_BACK)
-    # the top h rows of the window: GL counts rows from the bottom
-    data = GL.glReadPixels(0, height - h, w, h, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
-    pixels[:h, :w] = np.frombuffer(data, dtype=np.uint8).reshape(h, w, 3)[::-1]
+    data = GL.glReadPixels(x, y, w, h, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    pixels[row : row + h, column : column + w] = np.frombuffer(data, dtype=np.uint8).reshape(h, w, 3)[::-1]
     return pixels
