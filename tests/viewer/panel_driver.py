@@ -293,6 +293,32 @@ def orbit(workdir: Path) -> dict:
     return out
 
 
+def energy_legend(workdir: Path) -> dict:
+    """Ghosts on (G), the energy plot open (P), the drop (X): where ImPlot put the plot's legend, and
+    how many of its pixels are in each curve's colour."""
+    from ballpit.viewer.energyplot import KINETIC_COLOR, POTENTIAL_COLOR
+    from ballpit.viewer.ghosts import TINTS
+
+    viewer = panel_viewer(workdir)
+    press(viewer, "G", frames=2)
+    press(viewer, "P", frames=2)
+    press(viewer, "X", frames=40)
+    image = grab(viewer)
+    rects = viewer.panel.rects
+    out: dict = {"frame": rects["frame energy"], "legend": rects["legend energy"]}
+    x, y, w, h = (round(v) for v in rects["legend energy"])
+    region = image[y : y + h, x : x + w]
+    colors = {"kinetic": KINETIC_COLOR, "potential": POTENTIAL_COLOR} | {
+        name: (*rgb, 1.0) for name, rgb in TINTS.items()
+    }
+    out["swatches"] = {
+        name: int((np.abs(region - np.round(np.array(c[:3]) * 255)).max(axis=-1) < 12).sum())
+        for name, c in colors.items()
+    }
+    out["ghosts"] = len(viewer.shown.ghosts or ())
+    return out
+
+
 def _open_record_section(viewer: Viewer) -> None:
     """Fold the sections above it and open "Record video", so its button is on screen."""
     collapse(viewer, "Scenes", "Simulation", "Inspector")
@@ -362,6 +388,7 @@ SCENARIOS = {
         file_drop,
         add_ball,
         orbit,
+        energy_legend,
         record_button,
         record_without_pyav,
     )

@@ -20,6 +20,7 @@ BATCH = (
     "file_drop",
     "add_ball",
     "orbit",
+    "energy_legend",
     "record_button",
 )
 pytestmark = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
@@ -110,6 +111,18 @@ def test_a_double_clicked_ball_is_orbited_the_wheel_zooms_a_drag_turns_and_home_
     assert r["looks_at_target"] < 1e-9  # ...still looking at it
     active, eye, filed = r["after_home"]
     assert not active and np.allclose(eye, filed)  # the scene's view (it has a ground), flying free
+
+
+def test_the_energy_plots_legend_with_ghosts_stays_inside_the_plot_and_shows_every_curves_colour(
+    xvfb, tmp_path
+):
+    r = run_scenario(xvfb, "energy_legend", tmp_path)
+    assert r["ghosts"] == 3  # K, U and four totals: the widest the legend gets
+    fx, fy, fw, fh = r["frame"]
+    lx, ly, lw, lh = r["legend"]
+    assert fx <= lx and lx + lw <= fx + fw and fy <= ly and ly + lh <= fy + fh  # not clipped
+    for name, pixels in r["swatches"].items():  # each curve's swatch drawn in the legend, in its colour
+        assert pixels >= 50, (name, r["swatches"])
 
 
 def test_the_record_button_records_the_3d_view_at_simulated_time_and_a_second_click_writes_the_mp4(

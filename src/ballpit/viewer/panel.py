@@ -537,6 +537,7 @@ class Panel:
             for name in sorted(totals, key=lambda n: n == main):  # the run's own total on top
                 label = LABELS.get(name, name) if len(totals) > 1 else "E"
                 implot.plot_line(label, t, e[f"total {name}"], _spec((*TINTS[name], 1.0), 2.0))
+            self._remember_legend("energy")
             implot.end_plot()
         if self.plots["ball"] and implot.begin_plot("selected ball", size):
             self._remember("plot area ball")
@@ -565,6 +566,13 @@ class Panel:
                 spec.flags = implot.BarsFlags_.horizontal
                 implot.plot_bars("stage", np.array(list(traces.stages.values())), 0.67, 0, spec)
                 implot.end_plot()
+
+    def _remember_legend(self, name: str) -> None:
+        """Keep the plot's frame and its legend's rectangle as ImPlot laid them out (the last frame's),
+        so the tests can check that the legend is not clipped."""
+        plot = implot.internal.get_current_plot()
+        for key, rect in ((f"frame {name}", plot.frame_rect), (f"legend {name}", plot.items.legend.rect)):
+            self.rects[key] = (rect.min.x, rect.min.y, rect.get_width(), rect.get_height())
 
     # ------------------------------------------------------------------ View
     def _view(self, shown: Shown, watch: Watch) -> None:
