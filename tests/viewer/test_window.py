@@ -143,6 +143,7 @@ def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
         assert help_[0] <= text[0] and text[2] <= help_[2] and help_[1] <= text[1] and text[3] <= help_[3]
         if w["hud_drawn"]:
             assert not overlap(w["hud"], help_), name
+        assert help_[0] >= w["left"] and w["hud"][0] >= w["left"], name  # both right of the ImGui panel
     # 1280x720 has room for both side by side, 900x700 one above the other; 700x420 too, as the text
     # scales with the window (hud.font_size); 600x300 only for the help
     beside, above = r["1280x720"], r["900x700"]
@@ -150,6 +151,8 @@ def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
     assert above["hud_drawn"] and above["help"][1] >= above["hud"][3]
     assert r["700x420"]["hud_drawn"]
     assert not r["600x300"]["hud_drawn"]
+    # beside the ImGui panel the help's text shrinks to fit the 3-D view (950 px wide; 470 at 800x450)
+    assert r["800x450 panel"]["left"] == 330 and r["800x450 panel"]["help"][2] <= 800
     # in the real pixels: the HUD's bright text shows in its panel, the gap between the panels is scene
     image = np.array(r["1280x720"]["pixels"])
     hud, help_ = (np.array(r["1280x720"][k], dtype=int) for k in ("hud", "help"))
