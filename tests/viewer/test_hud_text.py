@@ -6,12 +6,14 @@ from __future__ import annotations
 import pytest
 
 
-def line_height(hud) -> float:
+def line_height(label) -> float:
+    """The height of a line of ``label``'s text, at its font size (the HUD's text scales with its
+    window, hud.font_size; the help's may be smaller still, to fit beside the panel)."""
     import pyglet
 
     from ballpit.viewer.hud import FONT
 
-    size = hud.label.font_size  # the HUD's text scales with its window (hud.font_size)
+    size = label.font_size
     one = pyglet.text.Label("Xg", font_name=FONT, font_size=size, multiline=True, width=4000)
     two = pyglet.text.Label("Xg\nXg", font_name=FONT, font_size=size, multiline=True, width=4000)
     return two.content_height - one.content_height
@@ -28,7 +30,7 @@ def test_the_help_is_laid_out_one_row_per_binding(hud):
     from ballpit.viewer.hud import help_text
 
     rows = help_text().count("\n") + 1
-    step = line_height(hud)
+    step = line_height(hud.help_label)
     assert hud.help_label.content_height == pytest.approx(rows * step, abs=step * 0.6)
     assert hud.help_label.width >= hud.help_label.content_width  # its lines fit: none is broken
 
@@ -36,7 +38,7 @@ def test_the_help_is_laid_out_one_row_per_binding(hud):
 def test_a_long_hud_line_stays_one_line(hud):
     lines = ["slopes.toml", "history     12.500 s in the past; Space resumes", "x" * 90]
     hud.set_text(lines)
-    step = line_height(hud)
+    step = line_height(hud.label)
     assert hud.label.content_height == pytest.approx(len(lines) * step, abs=step * 0.6)
     assert hud.panel.width >= hud.label.content_width  # the panel grows to fit the line
 
