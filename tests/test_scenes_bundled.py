@@ -19,7 +19,7 @@ from ballpit.physics.integrators import INTEGRATORS
 from ballpit.scene import bundled_scenes, load_scene, read_scene
 from ballpit.viewer.camera import Camera
 
-from .cli_runner import run_in_process
+from .cli.runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"

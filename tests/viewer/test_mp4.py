@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ..cli_runner import ROOT
-from ..cli_runner import run_in_process as ballpit
+from ..cli.runner import ROOT
+from ..cli.runner import run_in_process as ballpit
 from .conftest import line_of_balls
 
 
@@ -165,7 +165,7 @@ def test_ctrl_c_during_an_mp4_render_leaves_no_file(tmp_path):
     import signal
     import time
 
-    from ..test_cli import running, wait_for
+    from ..cli.test_commands import running, wait_for
 
     out = tmp_path / "long.mp4"
     args = ["render", "scenes/slopes.toml", "--out", out, "--duration", "30", "--size", "64x48"]

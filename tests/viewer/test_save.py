@@ -3,6 +3,7 @@ and loads back (``ballpit check`` too) into the same World as the one saved."""
 
 from __future__ import annotations
 
+import codecs
 import re
 import subprocess
 import sys
@@ -292,3 +293,12 @@ def test_a_bundled_scene_is_saved_in_the_current_directory_not_inside_the_packag
     own.write_text(SCENE)
     sim = Simulation(read_scene(own), own)
     assert save_scene(sim, camera) == own.parent / "drop-saved-1.toml"
+
+
+def test_a_scene_starting_with_a_byte_order_mark_saves_with_its_comments(tmp_path):
+    path = tmp_path / "notepad.toml"
+    path.write_bytes(codecs.BOM_UTF8 + SCENE.encode())
+    sim = Simulation(read_scene(path), path)
+    saved = save_scene(sim, Camera.looking_at((1.0, 2.0, 8.0), (0.0, 1.0, 0.0)))
+    assert "# A test scene: a ramp, a ball and a grid." in saved.read_text()
+    assert_same_world(read_scene(saved).world, sim.world)

@@ -55,7 +55,7 @@ class Mp4Writer:
     def __init__(self, path: Path | str, size: tuple[int, int], fps: float, kind: str = "file") -> None:
         import av
 
-        from ..writers import remove_stale_temps, temp_path
+        from ..cli.writers import remove_stale_temps, temp_path
 
         width, height = int(size[0]), int(size[1])
         if width % 2 or height % 2 or width < 2 or height < 2:
