@@ -357,8 +357,9 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     if (frame.largest_move[cols] > SUBSTEP_TRAVEL * r).any():
         return "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
-    if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
-        return DEEPER
+    # a solved contact that overlapped deeper is said last: a frame kept in spite of it (the last try)
+    # must still have met every pair it left out
+    deeper = bool((frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any())
     # how far each ball got from where it started (the others flew straight)
     far = np.zeros(n + 1)
     moved = state.body[:, X] - before[:, X]
@@ -386,15 +387,14 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         out = out.subset(near)
         start = np.minimum(out.gap, 0.0)
         out.gap = _gap_from(out, before, model, state) - start
-    if len(out) == 0:
-        return None
-    on_plane = out.kind == SPHERE_PLANE
-    smaller = np.where(
-        on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
-    )
-    if (out.gap < -DEEP_OVERLAP * smaller).any():
-        return "a pair left out overlaps deeper than DEEP_OVERLAP"
-    return None
+    if len(out):
+        on_plane = out.kind == SPHERE_PLANE
+        smaller = np.where(
+            on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
+        )
+        if (out.gap < -DEEP_OVERLAP * smaller).any():
+            return "a pair left out overlaps deeper than DEEP_OVERLAP"
+    return DEEPER if deeper else None
 
 
 def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) -> np.ndarray:
