@@ -67,15 +67,9 @@ STEPS = 60  # the split-at-impacts escape this search first found came at step 3
 
 
 @dataclass(frozen=True)
-class Box:
-    """One generated scene: a cube of side 2·half centred on the origin, its slope and its balls."""
+class Balls:
+    """What every generated scene has: gravity, the integrator and its step, and the balls."""
 
-    half: float
-    wall_restitution: float
-    wall_friction: float
-    slope_rotation: tuple[float, float, float]
-    slope_size: float
-    slope_spin: tuple[float, float, float]
     gravity: tuple[float, float, float]
     integrator: str
     dt: float
@@ -84,6 +78,18 @@ class Box:
     radii: tuple[float, ...]
     masses: tuple[float, ...]
     restitution: float
+
+
+@dataclass(frozen=True)
+class Box(Balls):
+    """One generated scene: a cube of side 2·half centred on the origin, its slope and its balls."""
+
+    half: float
+    wall_restitution: float
+    wall_friction: float
+    slope_rotation: tuple[float, float, float]
+    slope_size: float
+    slope_spin: tuple[float, float, float]
     crowd_limit: float | None = None  # inf: every step split at impacts (None: the world's default)
 
     def world(self) -> ballpit.World:
@@ -398,24 +404,16 @@ def _digest(contacts, world) -> bytes:
 
 
 @dataclass(frozen=True)
-class Turned:
+class Turned(Balls):
     """A closed cube of side 2·half, turned by ``turn`` (extrinsic x, y, z degrees), and its balls,
-    placed in the cube's frame. ``strike`` (ball, velocity in the cube's frame) is a ball thrown after
-    the others have fallen asleep (``sleep``): it is added then, at ``strike_at`` (the box's frame)."""
+    placed in the cube's frame (gravity too). ``strike`` (radius, mass, position, velocity in the cube's
+    frame) is a ball thrown once the others have fallen asleep (``sleep``)."""
 
     half: float
     turn: tuple[float, float, float]
     squares: bool
     wall_restitution: float
     wall_friction: float
-    gravity: tuple[float, float, float]  # in the cube's frame
-    integrator: str
-    dt: float
-    positions: tuple[tuple[float, float, float], ...]
-    velocities: tuple[tuple[float, float, float], ...]
-    radii: tuple[float, ...]
-    masses: tuple[float, ...]
-    restitution: float
     friction: float = 0.0
     substeps: int = 1
     sleep: bool = False
@@ -431,17 +429,25 @@ class Turned:
 
     def world(self) -> ballpit.World:
         turn = self.rotation()
-        world = ballpit.World(gravity=turn @ np.array(self.gravity), integrator=self.integrator,
-                              sleep=self.sleep, substeps=self.substeps)  # fmt: skip
+        world = ballpit.World(
+            gravity=turn @ np.array(self.gravity),
+            integrator=self.integrator,
+            sleep=self.sleep,
+            substeps=self.substeps,
+        )
         for axis in range(3):
             for sign in (-1.0, 1.0):
                 face = np.eye(3)[axis] * sign  # the wall's outward direction in the cube's frame
                 if self.squares:
                     # the +y square turned so that its normal faces in (−face), then with the cube
                     rotation = _euler_xyz(turn @ _facing(-face))
-                    plane = world.add_plane(position=turn @ (face * self.half), rotation=rotation,
-                                            size=2.0 * self.half, restitution=self.wall_restitution,
-                                            friction=self.wall_friction)  # fmt: skip
+                    plane = world.add_plane(
+                        position=turn @ (face * self.half),
+                        rotation=rotation,
+                        size=2.0 * self.half,
+                        restitution=self.wall_restitution,
+                        friction=self.wall_friction,
+                    )
                     assert np.allclose(plane.normal, -(turn @ face), atol=1e-9)
                 else:
                     world.add_plane(
@@ -452,10 +458,13 @@ class Turned:
                     )
         if self.positions:
             world.add_spheres(
-                np.array(self.positions) @ turn.T, radius=np.array(self.radii), mass=np.array(self.masses),
-                velocity=np.array(self.velocities) @ turn.T, restitution=self.restitution,
+                np.array(self.positions) @ turn.T,
+                radius=np.array(self.radii),
+                mass=np.array(self.masses),
+                velocity=np.array(self.velocities) @ turn.T,
+                restitution=self.restitution,
                 friction=self.friction,
-            )  # fmt: skip
+            )
         return world
 
     def throw(self, world: ballpit.World) -> None:
@@ -546,9 +555,28 @@ def _into(draw) -> np.ndarray:
     return signs
 
 
+def _corner_box(draw, half: float, into: np.ndarray, integrators, timesteps, elastic: bool) -> dict:
+    """A turned cube with gravity pressing into its corner or edge ``into``, one of ``integrators`` at
+    one of ``timesteps``; walls and balls elastic and frictionless, or each drawn dead to half so."""
+    dead = st.sampled_from([0.0, 0.5])
+    return dict(
+        half=half,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0 if elastic else draw(dead),
+        wall_friction=0.0 if elastic else draw(dead),
+        gravity=_corner_gravity(draw, into),
+        integrator=draw(st.sampled_from(integrators)),
+        dt=draw(st.sampled_from(timesteps)),
+        restitution=1.0 if elastic else draw(dead),
+        friction=0.0 if elastic else draw(dead),
+    )
+
+
 @st.composite
-def pressed_into_corners(draw, integrators=("euler", "rk2", "rk4", "symplectic"),
-                         timesteps=(1 / 60, 0.05, 0.1)) -> Turned:  # fmt: skip
+def pressed_into_corners(
+    draw, integrators=("euler", "rk2", "rk4", "symplectic"), timesteps=(1 / 60, 0.05, 0.1)
+) -> Turned:
     """1–6 balls of 0.1 mm to 5 cm pressed by gravity into an edge or a corner of a turned box, some
     moving at up to 10 m/s, heavy or light, elastic and frictionless or not, at large steps."""
     half = draw(st.sampled_from([1.0, 0.3]))
@@ -559,20 +587,11 @@ def pressed_into_corners(draw, integrators=("euler", "rk2", "rk4", "symplectic")
     speed = draw(st.sampled_from([0.0, 1.0, 10.0]))
     elastic = draw(st.booleans())
     return Turned(
-        half=half,
-        turn=_turn(draw),
-        squares=draw(st.booleans()),
-        wall_restitution=1.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
-        wall_friction=0.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
-        gravity=_corner_gravity(draw, into),
-        integrator=draw(st.sampled_from(integrators)),
-        dt=draw(st.sampled_from(timesteps)),
+        **_corner_box(draw, half, into, integrators, timesteps, elastic),
         positions=tuple(positions),
         velocities=tuple(draw(_vector(speed)) for _ in range(n)) if speed else ((0.0, 0.0, 0.0),) * n,
         radii=tuple(radii),
         masses=tuple(draw(st.lists(st.sampled_from([0.001, 0.1, 1.0, 10.0]), min_size=n, max_size=n))),
-        restitution=1.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
-        friction=0.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
     )
 
 
@@ -586,13 +605,38 @@ def fast_in_turned_squares(draw) -> Turned:
     positions = tuple(tuple(draw(st.floats(-(half - r), half - r)) for _ in range(3)) for r in radii)
     speed = draw(st.sampled_from([100.0, 1000.0]))
     return Turned(
-        half=half, turn=_turn(draw), squares=draw(st.booleans()), wall_restitution=1.0, wall_friction=0.0,
-        gravity=(0.0, -9.81, 0.0), integrator=draw(st.sampled_from(["rk2", "rk4", "euler"])),
-        dt=draw(st.sampled_from([1 / 60, 0.05, 0.1])), positions=positions,
-        velocities=tuple(draw(_vector(speed)) for _ in range(n)), radii=tuple(radii),
-        masses=tuple(draw(st.lists(st.floats(0.01, 2.0), min_size=n, max_size=n))), restitution=1.0,
+        half=half,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0,
+        wall_friction=0.0,
+        gravity=(0.0, -9.81, 0.0),
+        integrator=draw(st.sampled_from(["rk2", "rk4", "euler"])),
+        dt=draw(st.sampled_from([1 / 60, 0.05, 0.1])),
+        positions=positions,
+        velocities=tuple(draw(_vector(speed)) for _ in range(n)),
+        radii=tuple(radii),
+        masses=tuple(draw(st.lists(st.floats(0.01, 2.0), min_size=n, max_size=n))),
+        restitution=1.0,
         steps=20,
-    )  # fmt: skip
+    )
+
+
+def _floor_box(draw, elastic: bool) -> dict:
+    """A turned 2 m cube under plain gravity, any integrator at 1/240 or 1/60 s, its walls and balls
+    elastic and frictionless or half so."""
+    return dict(
+        half=1.0,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0 if elastic else 0.5,
+        wall_friction=0.0 if elastic else 0.5,
+        gravity=(0.0, -9.81, 0.0),
+        integrator=draw(st.sampled_from(INTEGRATOR_NAMES)),
+        dt=draw(st.sampled_from([1 / 240, 1 / 60])),
+        restitution=1.0 if elastic else 0.5,
+        friction=0.0 if elastic else 0.5,
+    )
 
 
 @st.composite
@@ -619,14 +663,12 @@ def overlapping_starts(draw) -> Turned:
     speed = draw(st.sampled_from([0.0, 1.0, 10.0, 20.0]))
     elastic = draw(st.booleans())
     return Turned(
-        half=half, turn=_turn(draw), squares=draw(st.booleans()),
-        wall_restitution=1.0 if elastic else 0.5, wall_friction=0.0 if elastic else 0.5,
-        gravity=(0.0, -9.81, 0.0), integrator=draw(st.sampled_from(INTEGRATOR_NAMES)),
-        dt=draw(st.sampled_from([1 / 240, 1 / 60])), positions=tuple(positions),
+        **_floor_box(draw, elastic),
+        positions=tuple(positions),
         velocities=((0.0, 0.0, 0.0),) + tuple(draw(_vector(speed)) for _ in range(n - 1)),
-        radii=tuple(radii), masses=(draw(st.sampled_from([1.0, 100.0])),) + (0.01,) * (n - 1),
-        restitution=1.0 if elastic else 0.5, friction=0.0 if elastic else 0.5,
-    )  # fmt: skip
+        radii=tuple(radii),
+        masses=(draw(st.sampled_from([1.0, 100.0])),) + (0.01,) * (n - 1),
+    )
 
 
 @st.composite
@@ -651,16 +693,19 @@ def struck_sleepers(draw) -> Turned:
     aim = target - start
     elastic = draw(st.booleans())
     return Turned(
-        half=half, turn=_turn(draw), squares=draw(st.booleans()),
-        wall_restitution=1.0 if elastic else 0.5, wall_friction=0.0 if elastic else 0.5,
-        gravity=(0.0, -9.81, 0.0), integrator=draw(st.sampled_from(INTEGRATOR_NAMES)),
-        dt=draw(st.sampled_from([1 / 240, 1 / 60])), positions=tuple(positions),
-        velocities=((0.0, 0.0, 0.0),) * n, radii=(r,) * n,
+        **_floor_box(draw, elastic),
+        positions=tuple(positions),
+        velocities=((0.0, 0.0, 0.0),) * n,
+        radii=(r,) * n,
         masses=tuple(draw(st.lists(st.sampled_from([0.1, 1.0, 10.0]), min_size=n, max_size=n))),
-        restitution=1.0 if elastic else 0.5, friction=0.0 if elastic else 0.5, sleep=True,
-        strike=(draw(st.sampled_from([r, r / 4])), draw(st.sampled_from([0.1, 1.0, 10.0])),
-                tuple(float(c) for c in start), tuple(float(c) for c in aim / np.linalg.norm(aim) * speed)),
-    )  # fmt: skip
+        sleep=True,
+        strike=(
+            draw(st.sampled_from([r, r / 4])),
+            draw(st.sampled_from([0.1, 1.0, 10.0])),
+            tuple(float(c) for c in start),
+            tuple(float(c) for c in aim / np.linalg.norm(aim) * speed),
+        ),
+    )
 
 
 @st.composite
@@ -680,15 +725,14 @@ def mass_chains(draw) -> Turned:
     top = draw(st.sampled_from([0.0, 1.0, 10.0]))
     velocities = [(0.0, 0.0, 0.0)] * (n - 1) + [tuple(float(c) for c in into / np.linalg.norm(into) * top)]
     elastic = draw(st.booleans())
+    timesteps = (1 / 240, 1 / 60, 0.05)
     return Turned(
-        half=half, turn=_turn(draw), squares=draw(st.booleans()),
-        wall_restitution=1.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
-        wall_friction=0.0 if elastic else draw(st.sampled_from([0.0, 0.5])),
-        gravity=_corner_gravity(draw, into), integrator=draw(st.sampled_from(INTEGRATOR_NAMES)),
-        dt=draw(st.sampled_from([1 / 240, 1 / 60, 0.05])), positions=tuple(positions),
-        velocities=tuple(velocities), radii=tuple(radii), masses=masses,
-        restitution=1.0 if elastic else 0.0, friction=0.0 if elastic else 0.5,
-    )  # fmt: skip
+        **_corner_box(draw, half, into, INTEGRATOR_NAMES, timesteps, elastic),
+        positions=tuple(positions),
+        velocities=tuple(velocities),
+        radii=tuple(radii),
+        masses=masses,
+    )
 
 
 def _energy(world: ballpit.World) -> float:

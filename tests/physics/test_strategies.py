@@ -74,8 +74,11 @@ def test_a_small_ball_pushed_out_of_a_big_one_beside_a_wall_does_not_fly_through
     turned_box(world, turn)
     big, small = 0.316, 0.001
     world.add_sphere(position=turn @ np.array([-1 + big, 0, 0]), radius=big, mass=100.0)
-    world.add_sphere(position=turn @ np.array([-1 + big - 0.26, 0, 0]), radius=small,
-                     velocity=turn @ np.array([-10.0, 0, 0]))  # fmt: skip
+    world.add_sphere(
+        position=turn @ np.array([-1 + big - 0.26, 0, 0]),
+        radius=small,
+        velocity=turn @ np.array([-10.0, 0, 0]),
+    )
     radii = world.spheres.radii
     for _ in range(120):
         world.step(1 / 240)

@@ -150,9 +150,17 @@ def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     return candidate
 
 
-def stick(slip: np.ndarray, spin: np.ndarray, n: np.ndarray, inv_mass_a: np.ndarray, inv_mass_b: np.ndarray,
-          inv_inertia_a: np.ndarray, inv_inertia_b: np.ndarray, arm_a: np.ndarray,
-          arm_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def stick(
+    slip: np.ndarray,
+    spin: np.ndarray,
+    n: np.ndarray,
+    inv_mass_a: np.ndarray,
+    inv_mass_b: np.ndarray,
+    inv_inertia_a: np.ndarray,
+    inv_inertia_b: np.ndarray,
+    arm_a: np.ndarray,
+    arm_b: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
     """The friction impulse P and rolling impulse R that together stop a contact's ``slip`` (its
     tangential contact-point velocity) and relative ``spin``: the two solved as one block, before the
     friction cone and the rolling limit are applied.

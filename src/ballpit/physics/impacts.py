@@ -130,8 +130,16 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
                        model.solver_iterations, jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
                        jacobi_from=jacobi_from)  # fmt: skip
     if interval is not None:
-        resting.hold_by_planes(island, c.gap[near], model.spheres.radius, v.copy(), v, min_normal_speed[near],
-                               imp.normal, interval)  # fmt: skip
+        resting.hold_by_planes(
+            island,
+            c.gap[near],
+            model.spheres.radius,
+            v.copy(),
+            v,
+            min_normal_speed[near],
+            imp.normal,
+            interval,
+        )
     scale = _keep_energy(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]

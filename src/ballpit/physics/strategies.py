@@ -160,8 +160,9 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         with prof.stage("impacts"):  # arrivals bounce in waves; then slower approaches stop
             impacts.in_waves(model, state, touching, batch, step.restitution_threshold, min_normal_speed,
                              step.events, now)  # fmt: skip
-            impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now,
-                                    interval=remaining)  # fmt: skip
+            impacts.stop_approaches(
+                model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
+            )
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, step.forces)
         with prof.stage("resting solve"):
