@@ -17,7 +17,12 @@ Per scene, medians over the runs of:
   one second after the landing;
 - with ``--threads``, the CPU each kind of thread used while the pile landed, in cores: the physics
   thread, the window's (main) thread, llvmpipe's rasteriser threads and the rest;
-- with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end.
+- with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end;
+- ``panel_ms_before`` and ``panel_ms_land``: the mean time the panel took per frame (building it with
+  ImGui and handing its triangles to GL, on the window's thread) before X and while the scene lands;
+  ``panel_cpu_ms_*`` the same in the window thread's CPU time (without the waits for the GIL and for a
+  core that the wall time holds while the physics thread runs).
+  ``--panel off`` opens the viewer with the panel hidden (F4), for a paired comparison of frame rates.
 
 ``--env NAME=VALUE`` sets a variable for the child before anything loads (LP_NUM_THREADS, ...); the
 load average of the machine at the start is printed, since the two cores may be shared.
@@ -42,8 +47,9 @@ from ballpit.viewer.app import Viewer
 
 name, seconds, quality, escape = sys.argv[1], float(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
 width, height, land = int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
+panel = sys.argv[8] == "on"
 path = default_scene_path().with_name(name + ".toml")
-viewer = Viewer(size=(width, height), scene_path=path, quality=quality)
+viewer = Viewer(size=(width, height), scene_path=path, quality=quality, panel=panel)
 sim = viewer.sim
 TICK = os.sysconf("SC_CLK_TCK")
 
@@ -111,6 +117,10 @@ def tick(_dt):
     elif phase == "before" and now >= state["at"]:
         frames, _, t = state["mark"]
         out["fps_before_x"] = (viewer.frames - frames) / (now - t)
+        out["panel_ms_before"] = viewer.panel.cost_ms() if panel else None
+        out["panel_cpu_ms_before"] = viewer.panel.cost_ms(cpu=True) if panel else None
+        viewer.panel.seconds.clear()
+        viewer.panel.cpu_seconds.clear()
         viewer.window.dispatch_event("on_key_press", key.X, 0)
         idle = getattr(viewer.physics, "idle_seconds", 0.0)
         captured = getattr(viewer.physics, "capture_seconds", 0.0)
@@ -125,6 +135,8 @@ def tick(_dt):
         if simulated >= land or now - t > 6 * land + 5:
             wall = now - t
             out["land_fps"] = (viewer.frames - frames) / wall
+            out["panel_ms_land"] = viewer.panel.cost_ms() if panel else None
+            out["panel_cpu_ms_land"] = viewer.panel.cost_ms(cpu=True) if panel else None
             out["land_rtf"] = simulated / wall
             samples = [s for s in state["samples"] if s is not None]
             out["hud_rtf"] = statistics.median(samples) if samples else None
@@ -182,7 +194,8 @@ print("RESULT " + json.dumps({"land_rtf": world.time / wall, "physics_cpu_per_si
 """
 
 COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fps_after_x",
-           "steps_per_second", "real_time_factor"]  # fmt: skip
+           "steps_per_second", "real_time_factor", "panel_ms_before", "panel_ms_land"]  # fmt: skip
+COLUMNS += ["panel_cpu_ms_before", "panel_cpu_ms_land"]
 THREAD_COLUMNS = ["cpu_physics", "cpu_main", "cpu_llvmpipe", "cpu_other", "physics_cpu_per_sim_s",
                   "cpu_physics_queued", "physics_asleep", "physics_idle", "physics_capture"]  # fmt: skip
 
@@ -193,6 +206,7 @@ def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: di
     its measurements."""
     command = [sys.executable, "-c", CHILD, scene, str(args.seconds), args.quality,
                "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land)]  # fmt: skip
+    command.append(args.panel)
     if headless:
         command = [sys.executable, "-c", HEADLESS, scene, str(args.land)]
     proc = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
@@ -210,6 +224,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--land", type=float, default=2.0, help="simulated seconds the landing lasts")
     parser.add_argument("--size", default="1280x720", help="window size, WIDTHxHEIGHT")
     parser.add_argument("--quality", default="auto", help="auto, low or high (the viewer's option)")
+    parser.add_argument("--panel", default="on", choices=("on", "off"), help="the panel shown or hidden")
     parser.add_argument("--escape", action="store_true", help="also time Esc, Esc in the middle of a step")
     parser.add_argument("--threads", action="store_true", help="CPU per kind of thread while it lands")
     parser.add_argument("--env", action="append", default=[], help="NAME=VALUE for the viewer process")
@@ -230,7 +245,7 @@ def main(argv: list[str] | None = None) -> int:
                 results[f"{scene} (headless)"].append(one_run(scene, args, size, env, headless=True))
     extra = f", {' '.join(args.env)}" if args.env else ""
     print(f"{time.strftime('%Y-%m-%d %H:%M')}, {size[0]}x{size[1]}, medians of {args.runs} runs, "
-          f"quality {args.quality}{extra}, load average {load} at the start")  # fmt: skip
+          f"quality {args.quality}, panel {args.panel}{extra}, load average {load} at the start")  # fmt: skip
     cols = COLUMNS + (THREAD_COLUMNS if args.threads else []) + (["escape_seconds"] if args.escape else [])
     print("| scene | " + " | ".join(cols) + " |\n|---|" + "---|" * len(cols))
     for scene, runs in results.items():

@@ -334,6 +334,17 @@ def test_view_validates_the_scene_before_opening_a_window(tmp_path):
     assert_user_error(ballpit("view", tmp_path / "missing.toml"), "missing.toml", "no such file")
 
 
+def test_view_of_an_unknown_name_suggests_the_close_bundled_scenes_and_lists_them_all():
+    r = ballpit("view", "slope")
+    assert_user_error(r, "'slope'", "did you mean slopes?")
+    assert "bundled scenes: billiards, cannon," in r.stderr and "pile10k" in r.stderr
+    r = ballpit("view", "cradel")
+    assert_user_error(r, "did you mean cradle?")
+    r = ballpit("view", "qqqq")
+    assert_user_error(r, "'qqqq'", "bundled scenes:")
+    assert "did you mean" not in r.stderr
+
+
 def test_scenes_lists_the_bundled_scenes():
     r = ballpit("scenes")
     assert r.returncode == 0

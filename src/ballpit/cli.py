@@ -369,6 +369,12 @@ def _view(args: argparse.Namespace) -> int:
         raise UsageError("--record and --replay cannot be used together")
     path = world = None
     if args.scene is not None:
+        from .scene.loading import unknown_scene
+
+        unknown = unknown_scene(args.scene)
+        if unknown is not None:
+            print(f"ballpit: {unknown}", file=sys.stderr)
+            return EXIT_BAD_INPUT
         path = resolve_scene_path(args.scene)
         world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
     trajectory = None

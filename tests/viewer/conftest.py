@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import select
 import shutil
 import subprocess
 import sys
@@ -39,44 +40,43 @@ def offscreen(offscreen_session):
     return offscreen_session
 
 
-def free_display() -> int:
-    """An X display number nobody is using."""
-    for n in range(90, 190):
-        if not Path(f"/tmp/.X{n}-lock").exists() and not Path(f"/tmp/.X11-unix/X{n}").exists():
-            return n
-    raise RuntimeError("no free X display number between :90 and :189")
-
-
 @pytest.fixture(scope="session")
 def xvfb():
-    """Start an Xvfb server for the window tests; yields its DISPLAY string (e.g. ":90")."""
+    """Start an Xvfb server for the window tests; yields its DISPLAY string (e.g. ":90"). Xvfb picks a
+    free display number itself and writes it to a pipe (``-displayfd``), so parallel test workers never
+    end up sharing one server (where one worker's pointer clicks would land in another's window)."""
     if shutil.which("Xvfb") is None:
         pytest.skip("Xvfb is not installed (apt-get install xvfb); .ci/run installs it")
-    last_error = ""
-    for _ in range(3):
-        n = free_display()
-        proc = subprocess.Popen(
-            ["Xvfb", f":{n}", "-screen", "0", "1280x720x24", "-nolisten", "tcp"],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-        )
-        socket = Path(f"/tmp/.X11-unix/X{n}")
-        deadline = time.monotonic() + 10
-        while time.monotonic() < deadline and proc.poll() is None and not socket.exists():
-            time.sleep(0.05)
-        if proc.poll() is None and socket.exists():
-            try:
-                yield f":{n}"
-            finally:
-                proc.terminate()
-                try:
-                    proc.wait(timeout=5)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-            return
+    read, write = os.pipe()
+    proc = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1280x720x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        pass_fds=(write,),
+    )
+    os.close(write)
+    number = b""
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and not number.endswith(b"\n"):
+        if not select.select([read], [], [], max(deadline - time.monotonic(), 0.0))[0]:
+            break
+        chunk = os.read(read, 16)
+        if not chunk:
+            break
+        number += chunk
+    os.close(read)
+    if proc.poll() is not None or not number.strip():
         proc.kill()
-        last_error = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
-    pytest.fail(f"Xvfb did not start: {last_error}")
+        error = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+        pytest.fail(f"Xvfb did not start: {error}")
+    try:
+        yield f":{int(number)}"
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
 
 
 def subprocess_env(display: str | None) -> dict[str, str]:

@@ -20,7 +20,7 @@ import window_driver as wd
 import ballpit
 from ballpit.physics import INTEGRATOR_NAMES
 from ballpit.viewer.ghosts import TINTS
-from ballpit.viewer.screen import plot_rect, timeline_bar
+from ballpit.viewer.screen import timeline_bar
 
 DT = 1 / 240  # the default timestep of a world built in code
 
@@ -68,7 +68,7 @@ def press_xdotool_drag(viewer, x0: float, x1: float, y: float) -> None:
 def bar_pixels(viewer) -> int:
     """How many pixels along the timeline bar's row have its colours (drawn, not just computed)."""
     image = wd.grab(viewer)
-    x, y, w, h = timeline_bar(viewer.window.width)
+    x, y, w, h = timeline_bar(viewer.window.width, viewer.panel.width)
     row = image[viewer.window.height - int(y + h / 2), int(x) : int(x + w)]
     return int((row[:, 2] > row[:, 0] + 40).sum())  # the blue of the bar over a dark background
 
@@ -109,7 +109,7 @@ def history_keys(workdir: Path) -> dict:
     out["labels"] = [c.label for c in viewer.renderer.draws.calls]
 
     wd.point_at(viewer)
-    x, y, w, bh = timeline_bar(viewer.window.width)
+    x, y, w, bh = timeline_bar(viewer.window.width, viewer.panel.width)
     press_xdotool_drag(viewer, x + 0.8 * w, x + 0.25 * w, y + bh / 2)  # real pointer: drag back to 25 %
     out["scrubbed_to"] = h.current
     out["scrub_expected"] = round(0.25 * h.latest)
@@ -129,10 +129,10 @@ def history_keys(workdir: Path) -> dict:
 
 
 def ghosts_and_plot(workdir: Path) -> dict:
-    viewer = wd.open_viewer(size=(800, 450), world=bounce_world())
+    viewer = wd.open_viewer(size=(1280, 720), world=bounce_world(), panel=True)
     sim = viewer.sim
     wd.press(viewer, "G")  # before the drop: the ghosts drop with X
-    wd.press(viewer, "P")
+    wd.press(viewer, "P")  # the panel's energy plot
     wd.press(viewer, "X", frames=180)  # 3 s: two bounces
     wd.press(viewer, "SPACE")
     steps = sim.timeline.history.current
@@ -151,15 +151,14 @@ def ghosts_and_plot(workdir: Path) -> dict:
     out["hud"] = viewer.hud.text
     out["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
     image = wd.grab(viewer)
-    x, y, w, h = plot_rect(viewer.window.width, viewer.window.height)
-    top = viewer.window.height - int(y + h)
-    region = image[top : top + int(h), int(x) : int(x + w)]
+    x, top, w, h = viewer.panel.rects["plot area energy"]  # window pixels, top row first
+    region = image[int(top) : int(top + h), int(x) : int(x + w)]
     tints = {name: tuple(round(255 * c) for c in TINTS[name]) for name in ("euler", "rk4")}
     out["plot_pixels"] = {
         name: int((np.abs(region - np.array(c)).max(axis=-1) < 40).sum()) for name, c in tints.items()
     }
-    green = (region[..., 1] > 180) & (region[..., 0] < 150) & (region[..., 2] < 150)
-    out["kinetic_pixels"] = int(green.sum())
+    pink = (region[..., 0] > 220) & (region[..., 1] < 160) & (region[..., 2] > 180)  # the kinetic energy
+    out["kinetic_pixels"] = int(pink.sum())
     series = sim.timeline.energy.series()
     out["series"] = sorted(series)
     out["span"] = float(series["time"][-1] - series["time"][0])
@@ -200,7 +199,7 @@ def replay(workdir: Path) -> dict:
     wd.press(viewer, "RIGHT")
     out["right_twice"] = [rp.current, frame_matches()]
     wd.point_at(viewer)
-    x, y, w, bh = timeline_bar(viewer.window.width)
+    x, y, w, bh = timeline_bar(viewer.window.width, viewer.panel.width)
     press_xdotool_drag(viewer, x + 0.5 * w, x + 0.1 * w, y + bh / 2)
     out["scrub"] = [rp.current, rp.latest, frame_matches()]
     wd.type_text(viewer, "+")  # time ×2

@@ -91,7 +91,8 @@ def ball_state(viewer: Viewer, i: int) -> dict:
 
 # ---------------------------------------------------------------------- scenarios
 def drag_throw(workdir: Path, paused: bool = False) -> dict:
-    """Pick the resting ball up, drag it right and up at a steady pixel rate, let go."""
+    """Pick the resting ball up, drag it right and up at a steady pixel rate; running, hold the pointer
+    still for 1.5 s (the spring settles the ball on it) and drag on; let go."""
     from pyglet.window import mouse as buttons
 
     viewer = scene_viewer(workdir, FLOOR_SCENE)
@@ -112,17 +113,30 @@ def drag_throw(workdir: Path, paused: bool = False) -> dict:
     out["after_grab"] = ball_state(viewer, 0)["position"]
     step_x, step_y = 4, 3  # pixels per frame
     held, times = [], []
-    for k in range(1, 21):
-        mouse(viewer, "on_mouse_drag", x + step_x * k, y + step_y * k, step_x, step_y, buttons.LEFT, 0)
-        pump(viewer, 1)
-        held.append(ball_state(viewer, 0))
-        times.append(sim.world.time)
-    out |= {"held": held, "held_times": times, "pixel_step": [step_x, step_y]}
+
+    def drag(frames: range) -> None:
+        for k in frames:
+            mouse(viewer, "on_mouse_drag", x + step_x * k, y + step_y * k, step_x, step_y, buttons.LEFT, 0)
+            pump(viewer, 1)
+            held.append(ball_state(viewer, 0))
+            times.append(sim.world.time)
+
+    drag(range(1, 21))
+    out |= {"held": held[:], "held_times": times[:], "pixel_step": [step_x, step_y]}
+    if not paused:  # the pointer stays put: the spring brings the ball to rest on it
+        still = []
+        for _ in range(90):
+            pump(viewer, 1)
+            still.append(ball_state(viewer, 0) | {"target": viewer.interaction.target.tolist()})
+        out["still"] = still
+        drag(range(21, 27))
     out["draws_while_held"] = [c.label for c in viewer.renderer.draws.calls]
     viewer._hud_at = 0.0
     pump(viewer, 1, dt=0.0)
     out["hud_while_held"] = viewer.hud.text
-    mouse(viewer, "on_mouse_release", x + step_x * 20, y + step_y * 20, buttons.LEFT, 0)
+    out["before_release"] = ball_state(viewer, 0)
+    end = 20 if paused else 26
+    mouse(viewer, "on_mouse_release", x + step_x * end, y + step_y * end, buttons.LEFT, 0)
     pump(viewer, 1, dt=0.0)  # no time passes: the ball has just been let go
     out["released"] = ball_state(viewer, 0)
     out["held_after_release"] = viewer.interaction.held_ball
@@ -140,6 +154,45 @@ def drag_throw(workdir: Path, paused: bool = False) -> dict:
 
 def drag_throw_paused(workdir: Path) -> dict:
     return drag_throw(workdir, paused=True)
+
+
+def spring_into_plane(workdir: Path) -> dict:
+    """Grab the ball resting on the square and pull it hard down through the square, then sideways
+    along it: after every step, the ball's height and its distance to the square (face, edge or
+    corner)."""
+    from pyglet.window import mouse as buttons
+
+    viewer = scene_viewer(workdir, RAMP_SCENE)
+    sim = viewer.sim
+    press(viewer, "X", frames=30)  # resting on the square
+    ball = sim.world.spheres[0]
+    x, y = window_point(viewer, np.array(ball.position))
+    mouse(viewer, "on_mouse_press", x, y, buttons.LEFT, 0)
+    pump(viewer, 1)
+    heights, gaps, targets = [], [], []
+    square = sim.world.planes[1]
+
+    def measure() -> None:
+        centre = np.array(sim.world.spheres[0].position)
+        heights.append(float(centre[1]))
+        gaps.append(float(square.distance(centre)))
+
+    sim.after_step.append(measure)
+    for k in range(1, 91):  # 1.5 s: down 150 px (about 2 m below the square), then 1.5 m along it
+        px, py = x + max(k - 30, 0), y - 5 * min(k, 30)
+        mouse(viewer, "on_mouse_drag", px, py, 1 if k > 30 else 0, 0 if k > 30 else -5, buttons.LEFT, 0)
+        pump(viewer, 1)
+        targets.append(viewer.interaction.target.tolist())
+    mouse(viewer, "on_mouse_release", x, y, buttons.LEFT, 0)
+    pump(viewer, 1)
+    return {
+        "heights": heights,
+        "gaps": gaps,
+        "targets": targets,
+        "radius": ball.radius,
+        "square": 1.0,
+        "final": ball_state(viewer, 0),
+    }
 
 
 def shoot(workdir: Path) -> dict:
@@ -345,7 +398,7 @@ def record_close_button(workdir: Path) -> dict:
     """--record: drop, reset, drop again, then the window's close button (pyglet's on_close)."""
     path = workdir / "live.toml"
     path.write_text(RAMP_SCENE)
-    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz")
+    viewer = Viewer(size=(320, 180), scene_path=path, record=workdir / "run.npz", panel=False)
     viewer.sim.step_budget = math.inf
     press(viewer, "X", frames=20)
     press(viewer, "R", frames=2)
@@ -362,7 +415,17 @@ def record_close_button(workdir: Path) -> dict:
 
 SCENARIOS = {
     f.__name__: f
-    for f in (drag_throw, drag_throw_paused, shoot, plane_tilt, plane_lift, home, save, record_close_button)
+    for f in (
+        drag_throw,
+        drag_throw_paused,
+        spring_into_plane,
+        shoot,
+        plane_tilt,
+        plane_lift,
+        home,
+        save,
+        record_close_button,
+    )
 }
 
 

@@ -61,8 +61,8 @@ def test_ghosts_show_each_integrators_drift_and_the_plot_draws_it(xvfb, tmp_path
     calls = dict((label, n) for label, n in r["calls"])
     assert calls["balls"] == 1 and calls["ghosts"] == 3  # one instanced call for the three ghost sets
     assert [label for label, _ in r["calls"]].count("balls") == 1
-    assert "screen lines" in calls
-    assert r["plot_pixels"]["euler"] > 20 and r["plot_pixels"]["rk4"] > 20  # one total line per integrator
+    # the panel's energy plot (P): one total line per integrator, in its ghost's colour
+    assert r["plot_pixels"]["euler"] > 20 and r["plot_pixels"]["rk4"] > 20
     assert r["kinetic_pixels"] > 50
     assert r["series"] == ["kinetic", "potential", "time", *(f"total {n}" for n in sorted(INTEGRATOR_NAMES))]
     assert r["span"] == pytest.approx(3.0, abs=0.05)

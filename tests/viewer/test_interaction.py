@@ -82,3 +82,30 @@ def test_a_selected_plane_turns_only_while_a_key_is_held_and_gets_its_own_motion
     assert np.allclose(world.planes[1].angular_velocity, [0.0, 0.1, 0.0])
     assert not hands.takes_key("RIGHT")  # → steps again
     assert sim.phase is Phase.WAITING
+
+
+def test_a_ball_pulled_by_the_mouse_joint_into_another_ball_pushes_it_and_never_passes_through_it():
+    # Two balls side by side on the ground, no gravity to hold them: the left one is grabbed and its
+    # target put 3 m beyond the right one. The spring drives it into its neighbour, which it must push
+    # along (momentum) rather than pass through.
+    world = ballpit.World(gravity=(0.0, 0.0, 0.0))
+    world.add_spheres([[0.0, 1.0, 0.0], [0.7, 1.0, 0.0]], radius=0.3, friction=0.0)
+    sim = Simulation(world)
+    hands = Interaction(sim)
+    camera = Camera.looking_at((0.0, 1.0, 6.0), (0.0, 1.0, 0.0))
+    from ballpit.viewer.picking import Ray
+
+    ray = Ray(np.array(camera.position), np.array([0.0, 0.0, -1.0]))
+    hands.press(ray, 0.0, 0.0, camera.forward)
+    assert hands.held_ball == 0
+    sim.start()
+    hands.target = np.array([3.7, 1.0, 0.0])
+    gaps = []
+    sim.after_step.append(
+        lambda: gaps.append(float(np.linalg.norm(world.spheres[1].position - world.spheres[0].position)))
+    )
+    for _ in range(240):
+        sim.advance(1 / 240)
+    assert min(gaps) > 0.6 - 1e-3  # never into the other ball
+    assert world.spheres[0].position[0] < world.spheres[1].position[0]  # still on its side
+    assert world.spheres[1].position[0] > 1.5  # pushed along

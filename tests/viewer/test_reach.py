@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.viewer.interaction import LIFT_SPEED, THROW_WINDOW, TILT_RATE
+from ballpit.viewer.interaction import LIFT_SPEED, SPRING_HERTZ, THROW_WINDOW, TILT_RATE
 
 from .conftest import run_driver, subprocess_env
 from .test_save import assert_same_or_round_off
@@ -26,6 +26,7 @@ needs_xdotool = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdot
 BATCH = (
     "drag_throw",
     "drag_throw_paused",
+    "spring_into_plane",
     "shoot",
     "plane_tilt",
     "plane_lift",
@@ -46,35 +47,77 @@ def drag_velocity(r: dict) -> np.ndarray:
     return (step_x * np.array(r["right"]) + step_y * np.array(r["up"])) * metres_per_pixel / r["frame"]
 
 
-@pytest.mark.parametrize("scenario", ["drag_throw", "drag_throw_paused"])
-def test_a_dragged_ball_follows_the_pointer_without_falling_and_leaves_with_the_drag_velocity(
-    xvfb, tmp_path, scenario
-):
-    r = run_scenario(xvfb, scenario, tmp_path)
+def test_a_paused_dragged_ball_follows_the_pointer_and_leaves_with_the_drag_velocity(xvfb, tmp_path):
+    """Paused, nothing steps: the held ball is placed along the drag (its path is clear), and letting go
+    gives it the drag's velocity."""
+    r = run_scenario(xvfb, "drag_throw_paused", tmp_path)
     assert r["grabbed"] == 0
     assert np.allclose(r["after_grab"], r["start"], atol=1e-9)  # picking it up does not move it
     v = drag_velocity(r)
     held = np.array([s["position"] for s in r["held"]])
     steps = np.diff(held, axis=0)  # one frame of pointer motion each
     assert np.allclose(steps, v * r["frame"], rtol=0, atol=1e-9)  # it follows, and does not fall
-    if scenario == "drag_throw_paused":
-        assert r["held_times"][0] == r["held_times"][-1]  # no time passed while held
-    else:
-        assert r["held_times"][-1] > r["held_times"][0]
+    assert r["held_times"][0] == r["held_times"][-1]  # no time passed while held
     assert "overlay lines" in r["draws_while_held"] and "overlay lines" not in r["draws_after_release"]
     assert "holding     ball 0, throw" in r["hud_while_held"]
     released = np.array(r["released"]["velocity"])
     assert np.allclose(released, v, rtol=1e-9, atol=1e-9)  # the drag's velocity over the last 0.1 s
     assert np.linalg.norm(v) > 3.0 and THROW_WINDOW == pytest.approx(0.1)
     assert r["held_after_release"] is None
-    if scenario == "drag_throw_paused":
-        assert r["paused_still"] == r["released"]  # paused: nothing moves until Space
-    # then free flight: v = v0 + g t, x = x0 + v0 t + g t²/2 (RK4 is exact for constant g)
+    assert r["paused_still"] == r["released"]  # paused: nothing moves until Space
+    assert_free_flight(r, released)
+
+
+def assert_free_flight(r: dict, released: np.ndarray) -> None:
+    """After letting go: v = v0 + g t, x = x0 + v0 t + g t²/2 (RK4 is exact for constant g)."""
     t, g = r["flight_time"], np.array(r["g"])
     assert t == pytest.approx(0.2, abs=0.005)
     assert np.allclose(r["flight"]["velocity"], released + g * t, atol=1e-9)
     x0 = np.array(r["released"]["position"])
     assert np.allclose(r["flight"]["position"], x0 + released * t + 0.5 * g * t * t, atol=1e-9)
+
+
+def test_a_dragged_ball_is_pulled_by_a_damped_spring_comes_to_rest_on_the_pointer_and_is_thrown(
+    xvfb, tmp_path
+):
+    """Running, the mouse joint pulls the ball: it lags the moving pointer, then settles on the still
+    pointer within the sag a 5 Hz spring allows under gravity (g/ω², 1 cm), at rest; a quick drag and
+    letting go throws it with the velocity it had, then it flies freely."""
+    r = run_scenario(xvfb, "drag_throw", tmp_path)
+    assert r["grabbed"] == 0
+    assert np.allclose(r["after_grab"], r["start"], atol=1e-9)
+    v = drag_velocity(r)
+    held = np.array([s["position"] for s in r["held"]])
+    target_path = np.array(r["start"]) + v * r["frame"] * np.arange(1, 21)[:, None]
+    assert np.linalg.norm(held[-1] - np.array(r["start"])) > 0.3  # it was carried along
+    assert np.linalg.norm(held[-1] - target_path[-1]) > 0.01  # but by a spring: it lags the pointer
+    last = r["still"][-1]
+    sag = np.linalg.norm(r["g"]) / (2 * np.pi * SPRING_HERTZ) ** 2
+    offset = np.array(last["position"]) - np.array(last["target"])
+    assert np.linalg.norm(offset) < 1.5 * sag + 1e-3
+    assert offset[1] < 0  # it hangs below the pointer, as a weight on a spring does
+    # at rest: the speed read between steps is only the g·dt each step adds and the spring takes back
+    assert np.linalg.norm(last["velocity"]) <= np.linalg.norm(r["g"]) * r["dt"]
+    assert "holding     ball 0, throw" in r["hud_while_held"]
+    released = np.array(r["released"]["velocity"])
+    assert np.allclose(released, r["before_release"]["velocity"], atol=1e-12)  # let go, not set
+    assert np.linalg.norm(released) > 1.0
+    assert released @ v / (np.linalg.norm(released) * np.linalg.norm(v)) > 0.8  # along the drag
+    assert r["held_after_release"] is None
+    assert_free_flight(r, released)
+
+
+def test_a_ball_pulled_into_a_square_by_the_spring_never_passes_through_it(xvfb, tmp_path):
+    r = run_scenario(xvfb, "spring_into_plane", tmp_path)
+    targets = np.array(r["targets"])
+    assert targets[:, 1].min() < r["square"] - 1.0  # the pointer asked for a point far below the square
+    heights, gaps = np.array(r["heights"]), np.array(r["gaps"])
+    assert len(heights) >= 360  # every step of the 1.5 s held
+    # pressed onto the square by about 40 g, slid along it, and never into it, let alone through it
+    assert heights.min() > r["square"]
+    assert gaps.min() > r["radius"] - 2e-3
+    assert np.ptp(np.array(r["targets"])[30:, 0]) > 1.0  # it was dragged along the square too
+    assert r["final"]["position"][1] > r["square"]
 
 
 def test_b_shoots_a_ball_along_the_view_at_the_speed_the_hud_shows(xvfb, tmp_path):

@@ -40,10 +40,11 @@ color = "#e0482f"
 OPENED: list[Viewer] = []
 
 
-def open_viewer(size: tuple[int, int] = (320, 180), **kwargs: object) -> Viewer:
+def open_viewer(size: tuple[int, int] = (320, 180), panel: bool = False, **kwargs: object) -> Viewer:
     """A viewer window without multisampling (no scenario looks at anti-aliased edges; the renderer
-    tests do), at ``size``."""
-    viewer = Viewer(size=size, **kwargs)
+    tests do), at ``size``; the panel hidden unless asked for (the scenarios here reach the 3-D view,
+    which at these sizes it would cover)."""
+    viewer = Viewer(size=size, panel=panel, **kwargs)
     viewer.sim.step_budget = math.inf  # exact simulated time per frame even on a loaded machine
     OPENED.append(viewer)
     return viewer
@@ -517,7 +518,9 @@ def pacing(workdir: Path) -> dict:
     from ballpit.scene import Scene, default_appearance
 
     world = balls_world()
-    viewer = Viewer(size=(320, 180), world=Scene(world, default_appearance(world), timestep=1.0 / 60.0))
+    viewer = Viewer(
+        size=(320, 180), world=Scene(world, default_appearance(world), timestep=1.0 / 60.0), panel=False
+    )
     OPENED.append(viewer)
     viewer.sim.before_step.append(lambda: time.sleep(0.03))
     out: dict = {}

@@ -65,6 +65,13 @@ class Columns:
         """The whole allocated array, spare rows included (for writing new rows)."""
         return self._arrays[name]
 
+    def remove(self, row: int) -> None:
+        """Drop row ``row``; the rows after it move up by one."""
+        for array in self._arrays.values():
+            array[row : self.count - 1] = array[row + 1 : self.count]
+        self.count -= 1
+        self._publish()
+
     def __getattr__(self, name: str) -> np.ndarray:
         arrays = self.__dict__.get("_arrays")
         if arrays is None or name not in arrays:
@@ -163,6 +170,12 @@ class State:
         """Room for ``extra`` more balls; returns their rows of the block, to be filled in."""
         rows = self._rows.reserve(extra)
         return self._rows.full("body")[rows]
+
+    def remove(self, row: int) -> None:
+        """Drop ball ``row`` (the later balls move up by one); every ball wakes."""
+        self._rows.remove(row)
+        self.sleep = Sleep()
+        self.sleep.fit(self.count)
 
 
 def with_static(rows: np.ndarray) -> np.ndarray:

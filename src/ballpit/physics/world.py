@@ -13,7 +13,17 @@ from time import perf_counter
 
 import numpy as np
 
-from . import energy, moving_planes, narrowphase, sleeping, strategies, validation
+from . import (
+    collision,
+    energy,
+    exact,
+    moving_planes,
+    narrowphase,
+    quaternion,
+    sleeping,
+    strategies,
+    validation,
+)
 from .bodies import Plane, PlaneList, Sphere, SphereList
 from .contacts import ContactRecord, EventLog
 from .forces import ForceTerm, free_acceleration
@@ -23,8 +33,10 @@ from .model import (
     BALL_RADIUS,
     BALL_RESTITUTION,
     FRICTION,
+    HOLLOW_INERTIA,
     PLANE_RESTITUTION,
     ROLLING_FRICTION,
+    SOLID_INERTIA,
     Model,
 )
 from .pairs import PairCache
@@ -32,6 +44,15 @@ from .profile import StepProfile
 from .resting import WarmStart
 from .snapshot import Snapshot
 from .state import Q, State, V, W, X
+
+
+def _index(kind: str, index: object, count: int) -> int:
+    """``index`` checked as the index of one of ``count`` balls or planes (TypeError/ValueError naming it)."""
+    if isinstance(index, bool) or not isinstance(index, int | np.integer):
+        raise TypeError(f"index must be a {kind}'s index, got {index!r}")
+    if not 0 <= index < count:
+        raise ValueError(f"index must be a {kind}'s index from 0 to {count - 1}, got {index}")
+    return int(index)
 
 
 def _model_number(name: str, doc: str, **checks: bool) -> property:
@@ -282,6 +303,73 @@ class World:
         moving_planes.set_orientation(pose, i, q)
         self._remember_planes()
         return Plane(self, i)
+
+    # ------------------------------------------------------------------ edits between steps
+    def set_sphere_size(self, index: int, radius: float | None = None, mass: float | None = None) -> None:
+        """Give ball ``index`` a new ``radius`` and/or ``mass``; its inverse mass and inertia follow
+        (2/5·m·r² solid, 2/3·m·r² hollow). Both are checked before either is written."""
+        i = self._ball_index(index)
+        cols = self.model.spheres
+        r = cols.radius[i] if radius is None else validation.number("radius", radius, positive=True)
+        m = cols.mass[i] if mass is None else validation.number("mass", mass, positive=True)
+        cols.radius[i], cols.mass[i] = r, m
+        cols.inv_mass[i] = 1.0 / m
+        shape_factor = HOLLOW_INERTIA if cols.hollow[i] else SOLID_INERTIA
+        cols.inv_inertia[i] = 1.0 / (shape_factor * m * r * r)
+        self._edited()
+
+    def remove_sphere(self, index: int) -> None:
+        """Remove ball ``index``; the balls after it move down one index."""
+        i = self._ball_index(index)
+        self.model.spheres.remove(i)
+        self.state.remove(i)
+        self._edited()
+
+    def move_plane(self, index: int, position: object = None, rotation: object = None) -> None:
+        """Put plane ``index``'s centre at ``position`` and/or turn it to ``rotation`` (extrinsic x, y, z
+        degrees from the +y plane, as ``add_plane``). Both are checked before either is written."""
+        index = _index("plane", index, self.model.planes.count)
+        pose = self.state.planes
+        limit = validation.MAX_COORDINATE
+        center = None if position is None else validation.vector("position", position, limit=limit)
+        q = None if rotation is None else quaternion.from_euler_xyz(validation.vector("rotation", rotation))
+        if center is not None:
+            pose.center[index] = center
+        if q is not None:
+            moving_planes.set_orientation(pose, index, q)
+        self._remember_planes()
+        self._edited()
+
+    def _ball_index(self, index: object) -> int:
+        return _index("ball", index, self.state.count)
+
+    def first_overlap(self, position: object, radius: float) -> str | None:
+        """What a ball of ``radius`` at ``position`` would overlap ("ball 3", "plane 0"), or None: the
+        check a ball added by hand should pass (``add_sphere`` itself allows overlaps, which the step
+        pushes apart)."""
+        p = validation.vector("position", position, limit=validation.MAX_COORDINATE)
+        r = validation.number("radius", radius, positive=True)
+        balls = self.state.body[:, X] - p
+        reach = self.model.spheres.radius + r
+        hit = np.flatnonzero(exact.dot(balls, balls) < reach * reach)
+        if hit.size:
+            return f"ball {hit[0]}"
+        pose, shape = self.state.planes, self.model.planes
+        k = np.arange(shape.count)
+        points = np.broadcast_to(p, (shape.count, 3))
+        near = collision.closest_point_on_planes(
+            points, k, pose.center, pose.axis_u, pose.axis_v, shape.half_size
+        )
+        gap = near - points
+        hit = np.flatnonzero(exact.dot(gap, gap) < r * r)
+        return f"plane {hit[0]}" if hit.size else None
+
+    def _edited(self) -> None:
+        """Something a step reads was changed by hand: the kept pairs and warm start are found afresh,
+        and sleeping balls wake."""
+        self._pairs = PairCache()
+        self._warm = WarmStart()
+        self.state.sleep.wake_all()
 
     def _remember_planes(self) -> None:
         """Copy the plane columns, to put back a bad value written into them before the next step."""

@@ -49,6 +49,21 @@ def default_scene_path() -> Path:
     return bundled_scenes_dir() / "slopes.toml"
 
 
+def unknown_scene(name: str) -> str | None:
+    """For a bare name that is neither a file nor a bundled scene ("slope"): one line naming the close
+    bundled names and listing them all; None for anything else (a path to a missing file says so)."""
+    path = Path(name)
+    stem = path.name.removesuffix(".toml")
+    if path.parent != Path(".") or not stem or resolve_scene_path(name).exists():
+        return None
+    import difflib
+
+    names = [p.stem for p in bundled_scenes()]
+    close = difflib.get_close_matches(stem, names, n=3, cutoff=0.5)
+    hint = f"did you mean {' or '.join(close)}? " if close else ""
+    return f"no scene file or bundled scene named {name!r}: {hint}bundled scenes: {', '.join(names)}"
+
+
 def resolve_scene_path(name: str | Path) -> Path:
     """A scene argument as a path: an existing file, else a bundled scene's name (``slopes``).
 

@@ -1,7 +1,10 @@
-"""The viewer window: pyglet event loop, input handling, camera flying, HUD, reload and screenshots.
+"""The viewer window: its parts put together, the frame, reload and save, the HUD's text, and the exit.
 
 ``run`` is what ``ballpit`` / ``ballpit view`` call. ``Viewer`` is the window itself; tests drive it
-frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window.
+frame by frame with ``Viewer.frame`` and real pyglet events dispatched into the real window. Its parts
+live beside it: the input (input.py: keys, pointer, files), the actions every key and panel button run
+(actions.py), the camera (view_control.py, orbit.py, framing.py), the panel (panel.py), the HUD
+(hud.py), recording (recording.py) and screenshots (screenshot.py).
 
 The physics runs beside the window on a thread of its own (stepper.py): the window draws the latest
 state it handed over and sends it what the keys and the mouse ask as commands, applied between steps.
@@ -16,10 +19,9 @@ import copy
 import sys
 import time
 from collections import deque
-from datetime import datetime
 from pathlib import Path
 
-from . import backend, controls
+from . import backend
 from .controls import Action
 from .handover import Needs, Shown
 from .pacing import FramePacer
@@ -28,7 +30,6 @@ from .simulation import Phase, Simulation
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
 HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
-SCREENSHOT_DIRECTORY = "screenshots"  # F12 saves here, under the current directory
 
 
 def default_scene() -> Path:
@@ -50,7 +51,8 @@ def title(scene_name: str, fps: float) -> str:
 class Viewer:
     """One window on one Simulation: of ``world`` (a Scene, or a World built in code), else of the scene
     file ``scene_path`` (the bundled demo by default). ``quality``: ``auto``, ``low`` or ``high``
-    (quality.py; auto is low on a software rasteriser such as llvmpipe, as in the window tests)."""
+    (quality.py; auto is low on a software rasteriser such as llvmpipe, as in the window tests).
+    ``panel``: whether the panel is shown at first (F4 shows and hides it)."""
 
     def __init__(
         self,
@@ -61,6 +63,7 @@ class Viewer:
         trajectory: object = None,
         record: Path | None = None,
         quality: str = "auto",
+        panel: bool = True,
     ) -> None:
         backend.use_window()
         import pyglet
@@ -68,10 +71,14 @@ class Viewer:
         from .camera import Camera
         from .frame import FrameFeeder, OverlayFlags
         from .hud import Hud
+        from .input import WindowInput
         from .interaction import Interaction
+        from .panel import Panel
         from .renderer import Renderer
         from .screen import ScreenOverlay
         from .stepper import PhysicsThread
+        from .view_control import ViewControl
+        from .watch import Traces
 
         if world is None:
             from ballpit.scene import read_scene
@@ -89,6 +96,8 @@ class Viewer:
             self.sim.start()  # a replay plays at once
         look = self.sim.appearance
         self.camera = Camera.looking_at(look.camera_position, look.camera_look_at)
+        self.view = ViewControl(self, self.camera)
+        self.orbit = self.view.orbit
         self.window = self._open_window(size, visible)
         self.renderer = Renderer()
         self.renderer_name = _gl_renderer()
@@ -97,7 +106,13 @@ class Viewer:
         self.feeder = FrameFeeder(self.renderer)
         self.flags = OverlayFlags()
         self.hud = Hud(self.window)
-        self.physics = PhysicsThread(self.sim, needs=self._needs)
+        self.traces = Traces()
+        self.sim.after_step.append(lambda: self.traces.sample(self.sim))
+        self.sim.after_reset.append(lambda: self.traces.follow(None))
+        self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch)
+        self.panel = Panel(self)
+        self.panel.shown = panel
+        self.view.scene_view(self.shown)
         self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
@@ -108,9 +123,7 @@ class Viewer:
         self._drawn_key: tuple | None = None
         self._drawn_shown: Shown | None = None  # keeps the object whose id is in the key alive
         self.views_drawn = 0  # how many frames drew the 3-D view (others showed the last one again)
-        self.held: set[str] = set()
-        self.mouse_captured = False
-        self._quit_armed_until = 0.0  # a second Esc before this time quits
+        self.input = WindowInput(self)
         self.closed = False
         self._window_closed = False
         self.screenshot_requested = False
@@ -127,6 +140,7 @@ class Viewer:
         self._shown_message = ""
         self.window.set_caption(title(look.name, 0.0))
         self.window.push_handlers(self)
+        self.window.push_handlers(self.input)
         self._pyglet = pyglet
 
     # ------------------------------------------------------------------ window
@@ -141,7 +155,7 @@ class Viewer:
         )
         return pyglet.window.Window(
             width=size[0], height=size[1], caption="ballpit", resizable=True, vsync=True,
-            visible=visible, config=config,
+            visible=visible, config=config, file_drops=True,
         )  # fmt: skip
 
     def set_quality(self, option: str) -> None:
@@ -163,8 +177,52 @@ class Viewer:
 
     def _needs(self) -> Needs:
         """What the physics should copy for the window (asked at every hand-over)."""
-        f, screen = self.flags, getattr(self, "screen", None)
-        return Needs(f.contacts, f.velocities, f.trails, energy=screen is not None and screen.show_plot)
+        f = self.flags
+        return Needs(f.contacts, f.velocities, f.trails)
+
+    def _watch(self, sim: Simulation) -> object:
+        """The panel's copy of the run (physics side, at each hand-over): settings, the selection,
+        and the traces while the plots are open."""
+        from .watch import watch
+
+        it = self.interaction
+        self.traces.follow(it.selected_ball)
+        selected = None
+        if it.selected_ball is not None:
+            selected = ("ball", it.selected_ball)
+        elif it.selected_plane is not None:
+            selected = ("plane", it.selected_plane)
+        return watch(sim, selected, self.traces if self.panel_plots else None)
+
+    @property
+    def panel_plots(self) -> bool:
+        panel = getattr(self, "panel", None)
+        return panel is not None and panel.wants_plots
+
+    def select(self, ball: int | None) -> None:
+        """Select ``ball`` in the inspector (None: nothing)."""
+
+        def choose(sim: Simulation) -> None:
+            self.interaction.deselect()
+            self.interaction.selected_ball = ball
+
+        self.command(choose)
+
+    def scene_opened(self) -> None:
+        """Another scene was opened: the camera goes to its view."""
+        self.physics.sync()  # its first hand-over, to frame it from
+        self.orbit.stop()
+        self.view.scene_view(self.shown)
+        self.window.set_caption(title(self.shown.appearance.name, self.fps))
+
+    # the input's state, read by the HUD, the actions and the tests
+    @property
+    def held(self) -> set[str]:
+        return self.input.held
+
+    @property
+    def mouse_captured(self) -> bool:
+        return self.input.mouse_captured
 
     @property
     def shown(self) -> Shown:
@@ -184,81 +242,11 @@ class Viewer:
             self.physics.show_again()
 
     def _perform(self, action: Action) -> None:
-        do = self.command
-        if action is Action.START:
-            do(lambda sim: sim.start())
-        elif action is Action.PAUSE:
-            do(lambda sim: sim.toggle_pause())
-        elif action is Action.STEP:
-            do(lambda sim: sim.step_once())
-        elif action is Action.RESET:
-            do(lambda sim: sim.reset())
-        elif action is Action.RELOAD:
-            self.reload()
-        elif action in controls.INTEGRATOR_ACTIONS:
-            name = controls.INTEGRATOR_ACTIONS[action]
-            do(lambda sim: sim.set_integrator(name))
-        elif action is Action.FASTER:
-            do(lambda sim: sim.faster())
-        elif action is Action.SLOWER:
-            do(lambda sim: sim.slower())
-        elif action is Action.CAPTURE_MOUSE:
-            self.capture_mouse(not self.mouse_captured)
-        elif action is Action.ESCAPE:
-            self.escape()
-        elif action is Action.CONTACTS:
-            self.flags.contacts = not self.flags.contacts
-        elif action is Action.VELOCITIES:
-            self.flags.velocities = not self.flags.velocities
-        elif action is Action.TRAILS:
-            self.flags.trails = not self.flags.trails
-        elif action is Action.HUD:
-            self.hud.show_hud = not self.hud.show_hud
-        elif action is Action.PROFILE:
-            self.hud.page = "stats" if self.hud.page == "profile" else "profile"
-            self.hud.show_hud = True
-        elif action is Action.HELP:
-            self.hud.show_help = not self.hud.show_help
-        elif action is Action.SCREENSHOT:
-            self.screenshot_requested = True
-        elif action is Action.QUALITY:
-            from .quality import other
+        from .actions import perform
 
-            self.set_quality(other(self.quality).name)
-            self.hud.flash(f"quality {self.quality.describe()}", time.perf_counter())
-        elif action in controls.TIME_ACTIONS:
-            do(controls.TIME_ACTIONS[action])
-        elif action is Action.ENERGY_PLOT:
-            self.screen.show_plot = not self.screen.show_plot
-        elif action is Action.SHOOT:
-            camera = copy.deepcopy(self.camera)
-            do(lambda sim: self.interaction.shoot(camera))
-        elif action is Action.SHOT_SPEED:
-            self.hud.flash(f"shot speed {self.interaction.next_shot_speed():g} m/s", time.perf_counter())
-        elif action is Action.HOME:
-            look = self.shown.appearance
-            self.camera.look_from(look.camera_position, look.camera_look_at)
-        elif action is Action.SAVE:
-            self.save_scene()
+        perform(self, action)
         self._hud_at = 0.0  # refresh the HUD on the next frame
         self.physics.refresh_hud()
-
-    def escape(self) -> None:
-        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
-        until then the HUD asks for it."""
-        now = time.perf_counter()
-        if not self.mouse_captured and self.interaction.selected_plane is not None:
-            self.command(lambda sim: self.interaction.deselect())
-            self.hud.flash("plane deselected", now)
-            return
-        outcome = controls.escape_outcome(self.mouse_captured, armed=now < self._quit_armed_until)
-        if outcome == "quit":
-            self.close()
-            return
-        if outcome == "release":
-            self.capture_mouse(False)
-        self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
-        self.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 
     def _watched(self, result: tuple[bool, str | None]) -> None:
         """The file watch's answer: the HUD's error, and a reload when the file changed."""
@@ -272,14 +260,17 @@ class Viewer:
         last good scene and the HUD shows the error."""
         self.command(lambda sim: (sim.reload(), sim.error)[1], self.hud.set_error)
 
-    def save_scene(self) -> None:
-        """Ctrl+S: write the scene as it stands to a new file beside the original; the HUD says where."""
+    def save_scene(self, path: Path | None = None) -> None:
+        """Ctrl+S: write the scene as it stands to a new file beside the original (or to ``path``, the
+        panel's Save as); the HUD says where."""
         camera = copy.deepcopy(self.camera)
 
         def save(sim: Simulation) -> Path | OSError:
-            from .save import save_scene
+            from .save import save_scene, save_scene_as
 
             try:
+                if path is not None:
+                    return save_scene_as(sim, camera, path, self.interaction.own_motion())
                 return save_scene(sim, camera, self.interaction.own_motion())
             except OSError as exc:
                 return exc
@@ -291,15 +282,8 @@ class Viewer:
             self.hud.flash(f"save failed: {result}", time.perf_counter())
             return
         self.last_save = result
-        shown = self.last_save
-        if shown.is_relative_to(Path.cwd()):
-            shown = shown.relative_to(Path.cwd())
         print(f"scene saved to {self.last_save}", flush=True)
-        self.hud.flash(f"scene saved to {shown}", time.perf_counter())
-
-    def capture_mouse(self, captured: bool) -> None:
-        self.mouse_captured = captured
-        self.window.set_exclusive_mouse(captured)
+        self.hud.flash(f"scene saved to {_near(self.last_save)}", time.perf_counter())
 
     def close(self) -> None:
         """Close the window. Outside pyglet's loop (``pump``) the close waits until the events being
@@ -313,6 +297,8 @@ class Viewer:
         self.finish_record()
         if not self._window_closed:
             self._window_closed = True
+            self.window.switch_to()
+            self.panel.backend.shutdown()
             self.window.close()
 
     def finish_record(self) -> None:
@@ -327,83 +313,16 @@ class Viewer:
                 path, steps, balls = finished
                 print(f"recorded {steps} steps ({balls} balls) to {path}", flush=True)
 
-    # ------------------------------------------------------------------ pyglet events
-    def on_key_press(self, symbol: int, modifiers: int) -> bool:
-        from pyglet.window import key
-
-        name = key.symbol_string(symbol)
-        ctrl = bool(modifiers & key.MOD_ACCEL)
-        if not (ctrl and name in controls.FLY_KEYS):  # Ctrl+S saves; it does not fly back
-            self.held.add(name)
-        if self.interaction.takes_key(name):  # arrows and PgUp/PgDn move a selected plane while held
-            return True
-        action = controls.action_for_key(name, ctrl=ctrl, shift=bool(modifiers & key.MOD_SHIFT))
-        if action is not None:
-            self.perform(action)
-        return True  # handled: stops pyglet's default "Esc closes the window"
-
-    def on_text(self, text: str) -> bool:
-        action = controls.action_for_text(text)
-        if action is not None:
-            self.perform(action)
-        return True
-
-    def on_key_release(self, symbol: int, modifiers: int) -> bool:
-        from pyglet.window import key
-
-        self.held.discard(key.symbol_string(symbol))
-        return True
-
-    def on_deactivate(self) -> None:
-        self.held.clear()
-
-    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        if button == mouse.LEFT and self.screen.press(x, y):  # on the timeline bar: scrub
-            return
-        from .picking import pointer_ray
-
-        if button == mouse.LEFT and not self.mouse_captured:
-            ray = pointer_ray(self.camera, x, y, self.window.width, self.window.height)
-            facing = self.camera.forward
-
-            def press(sim: Simulation) -> None:
-                sim.message = self.interaction.press(ray, x, y, facing) or sim.message
-
-            self.command(press)
-
-    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        self.screen.release()
-        if button == mouse.LEFT:
-            self.command(lambda sim: self.interaction.release())
-
-    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
-        from pyglet.window import mouse
-
-        if buttons & mouse.LEFT and self.screen.drag(x, y):
-            return
-        if buttons & mouse.LEFT:
-            self.interaction.move(x, y)
-        if buttons & mouse.RIGHT or self.mouse_captured:
-            self.camera.look(dx, dy)
-
-    def on_mouse_motion(self, x: int, y: int, dx: int, dy: int) -> None:
-        if self.mouse_captured:
-            self.camera.look(dx, dy)
-
-    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
-        self.camera.speed = controls.scrolled_fly_speed(self.camera.speed, scroll_y)
-
     def on_resize(self, width: int, height: int) -> None:
+        self.panel.backend.resize()
         self.hud.layout()  # pyglet's own handler (viewport, HUD projection) runs after this one
 
     def on_close(self) -> None:
         self.closed = True
         self.physics.stop()
         self.finish_record()
+        self.window.switch_to()
+        self.panel.backend.shutdown()  # before pyglet closes the window and its GL context
 
     def on_draw(self) -> None:
         self.frame()
@@ -415,14 +334,14 @@ class Viewer:
         now = time.perf_counter()
         elapsed = now - self._last_frame if dt is None else dt
         self._last_frame = now
-        self.camera.fly(
-            controls.fly_direction(self.held), min(elapsed, 0.1), controls.fly_speed_multiplier(self.held)
-        )
+        self.view.move(self.held, elapsed)
         self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
             self._watch_at = now + WATCH_INTERVAL
             # reads the file's signature and the error alone: the steps taken ahead stay (stepper.py)
             self.physics.submit(lambda sim: (sim.file_changed(), sim.error), self._watched, rewind=False)
+        self.camera.inset = self.panel.width / max(self.window.width, 1)
+        self.screen.left = self.panel.width
         started = time.perf_counter()
         if dt is None:
             self.physics.run_free()
@@ -448,6 +367,7 @@ class Viewer:
         view.finish(width, height)
         self._draw_hud(now, shown)
         self.screen.draw_labels()
+        self.panel.draw(shown)
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -460,8 +380,8 @@ class Viewer:
         if self.interaction.held_ball is not None:
             return None
         c = self.camera
-        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, width, height,
-                self.flags.contacts, self.flags.velocities, self.flags.trails, self.screen.show_plot,
+        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset, width, height,
+                self.flags.contacts, self.flags.velocities, self.flags.trails, self.panel.width,
                 self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
     def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:
@@ -493,8 +413,9 @@ class Viewer:
     def _draw_hud(self, now: float, shown: Shown) -> None:
         from .hud import hud_lines, profile_lines
 
-        if self.hud.bottom != self.screen.bottom_clearance():
+        if self.hud.bottom != self.screen.bottom_clearance() or self.hud.left != self.panel.width:
             self.hud.bottom = self.screen.bottom_clearance()
+            self.hud.left = self.panel.width
             self.hud.layout()
         if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + HUD_INTERVAL
@@ -521,32 +442,13 @@ class Viewer:
             self.window.set_caption(title(shown.appearance.name, self.fps))
 
     def save_screenshot(self, width: int, height: int, directory: Path | None = None) -> Path:
-        """Save the back buffer (what this frame drew, HUD included) as a PNG in ``directory``
-        (``screenshots/`` in the current directory, created if need be); prints the path and shows it
-        in the HUD."""
-        import numpy as np
-        from OpenGL import GL
-        from PIL import Image
+        """Save the back buffer (what this frame drew, panel and HUD included) as a PNG (screenshot.py);
+        prints the path and shows it in the HUD."""
+        from .screenshot import save_screenshot
 
-        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
-        GL.glReadBuffer(GL.GL_BACK)
-        data = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
-        image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1]
-        directory = Path.cwd() / SCREENSHOT_DIRECTORY if directory is None else directory
-        directory.mkdir(parents=True, exist_ok=True)
-        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-        path = directory / f"ballpit-{stamp}.png"
-        n = 1
-        while path.exists():
-            n += 1
-            path = directory / f"ballpit-{stamp}-{n}.png"
-        Image.fromarray(image).save(path)
-        self.last_screenshot = path.resolve()
+        self.last_screenshot = save_screenshot(width, height, directory)
         print(f"screenshot saved to {self.last_screenshot}", flush=True)
-        shown = self.last_screenshot
-        if shown.is_relative_to(Path.cwd()):
-            shown = shown.relative_to(Path.cwd())
-        self.hud.flash(f"screenshot saved to {shown}", time.perf_counter())
+        self.hud.flash(f"screenshot saved to {_near(self.last_screenshot)}", time.perf_counter())
         return self.last_screenshot
 
     def sync(self) -> None:
@@ -589,6 +491,11 @@ class Viewer:
         # schedule_once counts from the loop's tick (clock.last_ts) unless that is 0.2 s old
         base = now if clock.last_ts is None or now - clock.last_ts > 0.2 else clock.last_ts
         clock.schedule_once(self._redraw, max(self._due - base, 0.0))
+
+
+def _near(path: Path) -> Path:
+    """``path`` relative to the current directory when it is under it (as the HUD says it)."""
+    return path.relative_to(Path.cwd()) if path.is_relative_to(Path.cwd()) else path
 
 
 def _gl_renderer() -> str:

@@ -29,6 +29,9 @@ class Camera:
     far: float = 1500.0
     speed: float = 4.0  # fly speed, m/s
     look_sensitivity: float = 0.004  # radians per mouse pixel
+    # the share of the window's width a panel covers at its left: the whole view is drawn in the rest,
+    # centred there and as wide as it (so it shows a little more above and below)
+    inset: float = 0.0
 
     def __post_init__(self) -> None:
         self.position = np.asarray(self.position, dtype=float).copy()
@@ -84,9 +87,14 @@ class Camera:
 
     def projection_matrix(self, aspect: float) -> np.ndarray:
         """Eye → clip for a viewport of width/height ``aspect``, float32, pyrr layout."""
-        return matrix44.create_perspective_projection(
+        projection = matrix44.create_perspective_projection(
             self.fov_y_degrees, aspect, self.near, self.far, dtype=np.float32
         )
+        if self.inset:  # NDC x → (1 − inset)·x + inset, y → (1 − inset)·y
+            projection[0, 0] *= 1.0 - self.inset
+            projection[1, 1] *= 1.0 - self.inset
+            projection[2, 0] -= self.inset  # clip x gains inset·w (w = −z_eye)
+        return projection
 
     def view_projection(self, aspect: float) -> np.ndarray:
         """World → clip."""

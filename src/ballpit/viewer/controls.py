@@ -49,6 +49,7 @@ class Action(Enum):
     SHOT_SPEED = "change the shot speed"
     HOME = "camera back to the scene's view"
     SAVE = "save the scene as it stands to a new file"
+    PANEL = "show / hide the panel"
 
 
 KEY_ACTIONS: dict[str, Action] = {
@@ -73,6 +74,7 @@ KEY_ACTIONS: dict[str, Action] = {
     "P": Action.ENERGY_PLOT,
     "B": Action.SHOOT,
     "HOME": Action.HOME,
+    "F4": Action.PANEL,
 }
 
 CTRL_KEY_ACTIONS: dict[str, Action] = {"R": Action.RELOAD, "S": Action.SAVE}
@@ -139,13 +141,37 @@ HELP: tuple[tuple[str, str], ...] = (
     ("right drag or Tab", "look around (Tab captures the mouse)"),
     ("Esc", "release the mouse, drop a plane; twice quits"),
     ("C / V / T, P", "contacts, velocities, trails; energy plot"),
-    ("H / F1 / F2 / F3", "HUD / this help / time per stage / quality"),
+    ("H / F1 F2 F3 F4", "HUD, help, stage times, quality, panel"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),
     ("B / Shift+B", "shoot a ball along the view / its speed"),
     ("click a plane", "select it: arrows tilt it, PgUp/PgDn lift it"),
     ("Home", "camera back to the scene's view"),
 )
+
+
+# How a key is written in the help and beside the panel's buttons.
+KEY_NAMES = {
+    "SPACE": "Space",
+    "RIGHT": "Right",
+    "LEFT": "Left",
+    "ESCAPE": "Esc",
+    "TAB": "Tab",
+    "HOME": "Home",
+}
+
+
+def keys_for(action: Enum) -> str:
+    """The keys bound to ``action``, as the panel writes them beside its button ("X", "Ctrl+R / F5")."""
+    names = [f"Ctrl+{k}" for k, a in CTRL_KEY_ACTIONS.items() if a is action]
+    names += [f"Shift+{KEY_NAMES.get(k, k)}" for k, a in SHIFT_KEY_ACTIONS.items() if a is action]
+    names += [
+        KEY_NAMES.get(k, k).lstrip("_")
+        for k, a in KEY_ACTIONS.items()
+        if a is action and not k.startswith("NUM_")
+    ]
+    names += [t for t, a in TEXT_ACTIONS.items() if a is action and t in "+-"]
+    return " / ".join(names)
 
 
 def action_for_key(name: str, ctrl: bool = False, shift: bool = False) -> Action | None:

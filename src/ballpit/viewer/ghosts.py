@@ -8,6 +8,7 @@ that origin, the same reference for the main run and every ghost. No GL here.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from ..physics.integrators import INTEGRATORS as REGISTRY
@@ -71,6 +72,16 @@ class Ghosts:
                 history.drop_future()
             ghost.step(history.timestep)
             history.recorded(name)
+
+    def edited(self, change: Callable[[Any], object]) -> None:
+        """The main run was changed by hand: each ghost gets the same change (one it refuses, having
+        drifted elsewhere, is skipped) and keeps the changed state in its history."""
+        for name, ghost in self.worlds.items():
+            try:
+                change(ghost)
+            except (ValueError, TypeError, IndexError):
+                continue
+            self.histories[name].changed()
 
     def seek(self, step: int) -> None:
         """Follow the main run to ``step`` (as near as each ghost's history reaches)."""

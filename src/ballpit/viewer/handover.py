@@ -112,6 +112,7 @@ class Shown:
     path: Any = None  # the scene file (for the HUD's save/reload messages)
     time: float = 0.0  # the World's time (s) of the state copied
     step: int | None = None  # its step in the history (None before the drop, or in a replay)
+    watch: Any = None  # the panel's copy of the run (watch.py), when the window has a panel
 
     @property
     def ball_count(self) -> int:

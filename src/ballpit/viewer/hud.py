@@ -87,6 +87,7 @@ class Hud:
         self._message_until = 0.0
         self.help_hides_hud = False  # the window has no room for both: the help is drawn alone
         self.bottom = 0  # pixels kept clear at the bottom (the timeline bar): messages go above them
+        self.left = 0  # pixels kept clear at the left (the panel): everything is drawn right of them
         self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
         self.label = pyglet.text.Label(
@@ -112,13 +113,14 @@ class Hud:
     def layout(self) -> None:
         """Place the labels for the window's current size."""
         w, h = self.window.width, self.window.height
-        self.label.x, self.label.y = MARGIN + 6, h - MARGIN - 4
-        self.error_label.width = max(w - 2 * MARGIN, 100)
-        self.error_label.x, self.error_label.y = MARGIN, MARGIN + self.bottom
+        left = self.left + MARGIN
+        self.label.x, self.label.y = left + 6, h - MARGIN - 4
+        self.error_label.width = max(w - self.left - 2 * MARGIN, 100)
+        self.error_label.x, self.error_label.y = left, MARGIN + self.bottom
         label = self.error_label
         self.error_back.position = (label.x - 5, label.y - 3)
         self.error_back.width, self.error_back.height = label.content_width + 10, label.content_height + 6
-        self.message_label.x = MARGIN
+        self.message_label.x = left
         self.message_label.y = (
             MARGIN + self.bottom + (self.error_label.content_height + 6 if self.error else 0)
         )
@@ -127,7 +129,7 @@ class Hud:
     def _fit_panel(self) -> None:
         h = self.window.height
         pw, ph = self.label.content_width + 14, self.label.content_height + 10
-        self.panel.position = (MARGIN, h - MARGIN - ph)
+        self.panel.position = (self.left + MARGIN, h - MARGIN - ph)
         self.panel.width, self.panel.height = pw, ph
         self._place_help()
 

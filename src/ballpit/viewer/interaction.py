@@ -3,10 +3,14 @@
 No GL and no pyglet here: the window passes in pointer rays, held key names and frame times, so this is
 testable on its own, and the Simulation's step hooks keep a held ball where the pointer is.
 
-- A held ball follows the pointer in the plane facing the camera through its centre. While time runs
-  it is kinematic: before and after every physics step its position is set to the pointer's point and
-  its velocity to the drag's (it pushes other balls, but does not fall). Letting go throws it with the
-  drag's velocity, measured over the last ``THROW_WINDOW`` seconds of frames.
+- A held ball is pulled towards the pointer's point in the plane facing the camera through its centre
+  by a soft spring, a mouse joint (MuJoCo's perturbation, Box2D's ``b2MouseJoint``): before every
+  physics step its velocity is changed as Box2D v3's soft constraint would (``spring_velocity``). The
+  step then moves it like any ball, so it keeps colliding, with continuous collision against planes and
+  balls: it never passes through either. Letting go leaves it with the velocity it has, so a quick drag
+  throws it. While time stands still (paused, before X) it is moved along the drag's path only as far
+  as that path is clear of balls and planes, and letting go gives it the drag's velocity, measured
+  over the last ``THROW_WINDOW`` seconds of frames.
 - A selected plane turns at ``TILT_RATE`` about a horizontal axis while an arrow key is held (← / →
   about the view's horizontal forward axis, ↑ / ↓ about its right axis) and moves at ``LIFT_SPEED`` up or
   down while PgUp / PgDn is held; letting go gives it back the motion it had when selected.
@@ -27,6 +31,11 @@ from .picking import Ray, camera_basis, pick, pointer_ray, ray_plane_point
 from .simulation import Phase, Simulation
 
 THROW_WINDOW = 0.1  # s of pointer motion the throw velocity is measured over
+# The mouse joint: a spring of this frequency and damping ratio (stiffness k = m·ω², damping c = 2·m·ζ·ω
+# with ω = 2π·f, so the pull is the same for a light ball as for a heavy one), its acceleration capped
+SPRING_HERTZ = 5.0
+SPRING_DAMPING = 0.7
+SPRING_MAX_ACCELERATION = 400.0  # m/s², about 40 g
 TILT_RATE = 0.4  # rad/s while an arrow key is held (about 23°/s)
 LIFT_SPEED = 1.0  # m/s while PgUp / PgDn is held
 SHOT_SPEEDS = (5.0, 10.0, 20.0, 40.0)  # m/s; Shift+B steps through them
@@ -61,6 +70,56 @@ def typical_material(spheres: object) -> dict[str, float]:
     return dict(zip(names, (float(v) for v in kinds[best]), strict=True))
 
 
+def spring_velocity(
+    position: np.ndarray,
+    velocity: np.ndarray,
+    target: np.ndarray,
+    target_velocity: np.ndarray,
+    h: float,
+    hertz: float = SPRING_HERTZ,
+    damping: float = SPRING_DAMPING,
+    max_acceleration: float = SPRING_MAX_ACCELERATION,
+) -> np.ndarray:
+    """The velocity a ball has after one step ``h`` of a soft mouse joint pulling it to ``target``
+    (Box2D v3, ``b2MakeSoft``: ω = 2πf, bias rate ω/(2ζ + hω), mass scale hω(2ζ + hω)/(1 + hω(2ζ + hω))).
+    The ball's mass cancels: stiffness and damping are scaled by it. The change is at most
+    ``max_acceleration``·h."""
+    omega = 2.0 * np.pi * hertz
+    a1 = 2.0 * damping + h * omega
+    a2 = h * omega * a1
+    bias_rate, mass_scale = omega / a1, a2 / (1.0 + a2)
+    c = np.asarray(position, float) - np.asarray(target, float)
+    cdot = np.asarray(velocity, float) - np.asarray(target_velocity, float)
+    change = -mass_scale * (cdot + bias_rate * c)
+    size = float(np.sqrt((change * change).sum()))
+    limit = max_acceleration * h
+    if size > limit:
+        change *= limit / size
+    return np.asarray(velocity, float) + change
+
+
+def clear_path(world: object, index: int, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """How far along the segment from ``start`` to ``end`` ball ``index`` can be moved without touching
+    another ball or a plane: the last clear point of samples half a radius apart (a ball's centre
+    cannot cross a plane, or meet a ball, between two clear samples that close)."""
+    spheres = world.spheres  # type: ignore[attr-defined]
+    r = float(spheres.radii[index])
+    start, end = np.asarray(start, float), np.asarray(end, float)
+    d = end - start
+    n = max(1, int(np.ceil(np.sqrt((d * d).sum()) / (0.5 * r))))
+    samples = start + d * (np.arange(1, n + 1) / n)[:, None]
+    others = np.delete(np.arange(len(spheres)), index)
+    blocked = np.zeros(n, dtype=bool)
+    if others.size:
+        gap = samples[:, None, :] - np.asarray(spheres.positions)[others][None, :, :]
+        reach = np.asarray(spheres.radii)[others] + r
+        blocked |= ((gap * gap).sum(axis=-1) < reach * reach).any(axis=1)
+    for plane in world.planes:  # type: ignore[attr-defined]
+        blocked |= np.asarray(plane.distance(samples)) < r
+    first = int(np.argmax(blocked)) if blocked.any() else n
+    return samples[first - 1] if first > 0 else start
+
+
 class Interaction:
     """What the user's hands are doing to one Simulation: a held ball, a selected plane, the shot speed."""
 
@@ -69,14 +128,14 @@ class Interaction:
         self.shot_speed = DEFAULT_SHOT_SPEED
         self.clock = 0.0  # seconds of frames so far; throw velocities are measured on it
         self.held_ball: int | None = None
+        self.selected_ball: int | None = None  # the inspector's ball (the last one clicked)
         self.selected_plane: int | None = None
         self.pointer = (0.0, 0.0)
         self.target = np.zeros(3)  # where the held ball's centre goes
         self._offset = np.zeros(3)  # ball centre minus the point under the pointer
         self._samples: deque[tuple[float, np.ndarray]] = deque()
         self._base_motion = (np.zeros(3), np.zeros(3))  # the selected plane's own (velocity, spin)
-        sim.before_step.append(self._hold)
-        sim.after_step.append(self._hold)
+        sim.before_step.append(self._pull)
         sim.after_reset.append(self.clear)
 
     # ------------------------------------------------------------------ pointer
@@ -87,10 +146,14 @@ class Interaction:
         hit = pick(ray, self.sim.world)
         if hit is None:
             self.deselect()
+            self.selected_ball = None
             return ""
         if hit.kind == "plane":
             self.select(hit.index)
+            self.selected_ball = None
             return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+        self.deselect()
+        self.selected_ball = hit.index
         if self.in_replay:
             return NOT_IN_REPLAY.format("dragging a ball")
         ball = self.sim.world.spheres[hit.index]
@@ -109,14 +172,17 @@ class Interaction:
         self.pointer = (float(x), float(y))
 
     def release(self) -> np.ndarray | None:
-        """Left button up: let go of a held ball with the drag's velocity (returned), if one is held."""
+        """Left button up: let go of a held ball (returns its velocity then). While time runs it keeps
+        the velocity the spring gave it; while time stands still it gets the drag's."""
         if self.held_ball is None:
             return None
-        velocity = self.throw_velocity()
         ball = self.sim.world.spheres[self.held_ball]
-        ball.position = self.target
-        ball.velocity = velocity
-        ball.angular_velocity = (0.0, 0.0, 0.0)
+        if self.sim.phase is not Phase.RUNNING:
+            index = self.held_ball
+            self.sim.edit(
+                lambda world: setattr(world.spheres[index], "velocity", self.throw_velocity()), False
+            )
+        velocity = np.array(ball.velocity, dtype=float)
         self.held_ball = None
         self._samples.clear()
         return velocity
@@ -150,20 +216,31 @@ class Interaction:
         self._samples.append((self.clock, self.target.copy()))
         while len(self._samples) > 2 and self._samples[1][0] <= self.clock - THROW_WINDOW:
             self._samples.popleft()
-        if self.sim.phase is not Phase.RUNNING:  # no steps to carry it: place it now
-            ball = self.sim.world.spheres[self.held_ball]
-            ball.position = self.target
-            ball.velocity = (0.0, 0.0, 0.0)
-            ball.angular_velocity = (0.0, 0.0, 0.0)
+        if self.sim.phase is not Phase.RUNNING:  # no steps to carry it: move it as far as is clear
+            index = self.held_ball
 
-    def _hold(self) -> None:
-        """Step hook: a held ball sits at the pointer's point, moving with the drag's velocity."""
-        if self.held_ball is None:
+            def place(world: object) -> None:
+                ball = world.spheres[index]  # type: ignore[attr-defined]
+                ball.position = clear_path(world, index, ball.position, self.target)
+                ball.velocity = (0.0, 0.0, 0.0)
+                ball.angular_velocity = (0.0, 0.0, 0.0)
+
+            self.sim.edit(place, ghosts=False)
+
+    def _pull(self) -> None:
+        """Step hook: the mouse joint changes a held ball's velocity before the step (which then moves
+        it, colliding as usual). The history keeps the pulled state, so stepping back repeats it."""
+        if self.held_ball is None or self.held_ball >= self.sim.ball_count:
             return
-        ball = self.sim.world.spheres[self.held_ball]
-        ball.position = self.target
-        ball.velocity = self.throw_velocity()
-        ball.angular_velocity = (0.0, 0.0, 0.0)
+        index, h = self.held_ball, self.sim.timestep
+
+        def pull(world: object) -> None:
+            ball = world.spheres[index]  # type: ignore[attr-defined]
+            ball.velocity = spring_velocity(
+                ball.position, ball.velocity, self.target, self.throw_velocity(), h
+            )
+
+        self.sim.edit(pull, ghosts=False)
 
     # ------------------------------------------------------------------ planes
     def select(self, index: int) -> None:
@@ -239,6 +316,7 @@ class Interaction:
     def clear(self) -> None:
         """Reset hook: the world was replaced, so let go of everything (nothing to give back)."""
         self.held_ball = None
+        self.selected_ball = None
         self.selected_plane = None
         self._samples.clear()
 

@@ -47,8 +47,9 @@ def pointer_ray(camera: Camera, x: float, y: float, width: int, height: int) -> 
     """The ray from the eye through window point (x, y) of a ``width`` × ``height`` window."""
     right, up, forward = camera_basis(camera)
     tan_half = math.tan(math.radians(camera.fov_y_degrees) / 2.0)
-    ndc_x = 2.0 * x / width - 1.0
-    ndc_y = 2.0 * y / height - 1.0
+    keep = 1.0 - camera.inset  # the view fills the part of the window right of the panel
+    ndc_x = (2.0 * x / width - 1.0 - camera.inset) / keep
+    ndc_y = (2.0 * y / height - 1.0) / keep
     direction = forward + (ndc_x * tan_half * width / height) * right + (ndc_y * tan_half) * up
     return Ray(np.asarray(camera.position, dtype=float).copy(), direction / np.linalg.norm(direction))
 

@@ -17,6 +17,7 @@ the original's own comments, kept below it, describe its start and its run, not 
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass
 from datetime import datetime
@@ -348,3 +349,21 @@ def save_scene(
             return path.resolve()
         except FileExistsError:  # someone took the name since we looked
             continue
+
+
+def save_scene_as(
+    sim: Simulation,
+    camera: Camera,
+    path: Path,
+    plane_motion: dict[int, tuple[np.ndarray, np.ndarray]] | None = None,
+) -> Path:
+    """Write the scene as it stands to ``path`` (the panel's Save as; ``.toml`` is added if missing),
+    replacing that file whole or not at all; returns its path."""
+    path = Path(path)
+    if path.suffix != ".toml":
+        path = path.with_name(path.name + ".toml")
+    text = scene_text(sim, camera, plane_motion)
+    partial = path.with_name(f"{path.name}.{os.getpid()}.partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)
+    return path.resolve()

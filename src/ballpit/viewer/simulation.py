@@ -266,16 +266,8 @@ class Simulation:
             self.error = "no scene file to reload (this world was built in code)"
             return False
         self._signature = _file_signature(self.path)
-        try:
-            scene = self.loader(self.path)
-        except Exception as exc:  # any failure: the viewer must stay up with the old world
-            self.error = f"reload of {self.path.name} failed: {_describe(exc)}"
-            print(f"ballpit: {self.error} (keeping the last good scene)", file=sys.stderr, flush=True)
-            return False
-        self._install(scene)
-        self.error = None
-        self.message = f"reloaded {self.path.name}: press X to drop"
-        return True
+        name = self.path.name
+        return self._load(self.path, f"reload of {name} failed", f"reloaded {name}", "the last good scene")
 
     def file_changed(self) -> bool:
         """True once each time the scene file's modification time or size changes."""
@@ -367,10 +359,52 @@ class Simulation:
         for hook in self.after_step:
             hook()
 
+    def edit(self, change: Callable[[object], object], ghosts: bool = True) -> object:
+        """A change by hand between steps: ``change(world)`` (a World method that refuses bad values
+        with ValueError/TypeError and then changes nothing). The history keeps the changed state as the
+        present (re-stepping starts from it; any later steps are dropped) and, with ``ghosts``, each
+        ghost gets the same change, so an edited run is recorded and compared as what it is. A replay
+        refuses (ValueError): it writes the recorded frames into the world."""
+        if self.timeline.replay is not None:
+            raise ValueError("a replay plays a recorded run: it cannot be edited")
+        result = change(self.world)
+        self.timeline.edited(change if ghosts else None)
+        return result
+
+    def remove_ball(self, index: int) -> None:
+        """Remove ball ``index`` (it and the ghosts' copies); what is kept per ball shrinks with it."""
+        self.edit(lambda world: world.remove_sphere(index))
+        look = self.appearance
+        look.sphere_colors = np.delete(look.sphere_colors, index, axis=0)
+        self.prev_positions = np.delete(self.prev_positions, index, axis=0)
+        self.prev_orientations = np.delete(self.prev_orientations, index, axis=0)
+        self.trails = Trails(self.ball_count)
+        self.trails.record(np.asarray(self.world.spheres.positions, dtype=np.float32), self.world.time)
+
+    def open(self, path: Path) -> bool:
+        """Open another scene file in place of this one; on any error keep the scene running and
+        remember the error (as a failed reload does)."""
+        path = Path(path)
+        return self._load(path, f"cannot open {path.name}", f"opened {path.name}", "the current scene")
+
+    def _load(self, path: Path, failed: str, done: str, kept: str) -> bool:
+        """Put the scene file ``path`` in place of the world; on any error keep the world running and
+        say ``failed`` (with the reason) in ``error`` and on stderr."""
+        try:
+            scene = self.loader(path)
+        except Exception as exc:  # any failure: the viewer must stay up with the old world
+            self.error = f"{failed}: {_describe(exc)}"
+            print(f"ballpit: {self.error} (keeping {kept})", file=sys.stderr, flush=True)
+            return False
+        self._install(scene)
+        self.error = None
+        self.message = f"{done}: press X to drop"
+        return True
+
     def add_ball(self, color: object, **kwargs: object) -> int:
         """Add a ball to the live world (``World.add_sphere`` arguments) drawn in ``color``; returns its
         index. Everything kept per ball (colours, trails, interpolation) grows with it."""
-        ball = self.world.add_sphere(**kwargs)
+        ball = self.edit(lambda world: world.add_sphere(**kwargs))
         look = self.appearance
         look.sphere_colors = np.vstack([look.sphere_colors, np.asarray(color, dtype=float).reshape(1, 3)])
         self.prev_positions = np.vstack([self.prev_positions, ball.position])

@@ -82,9 +82,15 @@ Then = Callable[[Any], None]
 class PhysicsThread:
     """Steps one Simulation beside the window and hands over a ``Shown`` after every batch of steps."""
 
-    def __init__(self, sim: Simulation, needs: Callable[[], Needs] = Needs) -> None:
+    def __init__(
+        self,
+        sim: Simulation,
+        needs: Callable[[], Needs] = Needs,
+        watch: Callable[[Simulation], Any] | None = None,
+    ) -> None:
         self.sim = sim
         self.needs = needs  # what the window draws now (asked at each capture)
+        self.watch = watch  # the panel's copy of the run, made at each capture (Shown.watch)
         self.lock = threading.Lock()  # held while the World changes: a step, a command, a capture
         self._handover_lock = threading.Lock()
         self._commands: deque[tuple[Command, Then | None, bool]] = deque()
@@ -356,7 +362,10 @@ class PhysicsThread:
             hud = HudFacts.of(self.sim)
             self._hud, self._hud_at = hud, now + HUD_INTERVAL
         self.captures += 1
-        return capture(self.sim, needs, hud=hud)
+        shown = capture(self.sim, needs, hud=hud)
+        if self.watch is not None:
+            shown.watch = self.watch(self.sim)
+        return shown
 
     def _publish(self, force_hud: bool) -> None:
         started = time.perf_counter()

@@ -100,6 +100,14 @@ class Timeline:
         h.drop_future()
         return True
 
+    def edited(self, change: Callable[[Any], object] | None) -> None:
+        """The world was changed by hand at the present step: the history keeps the changed state (the
+        steps after it are dropped); ``change``, if given, is made to each ghost as well."""
+        if self.history is not None:
+            self.history.changed()
+        if self.ghosts is not None and change is not None:
+            self.ghosts.edited(change)
+
     # ------------------------------------------------------------------ moving in time
     def seek(self, step: int) -> bool:
         """Go to ``step`` of the source; the ghosts follow. False when there is nothing to move in."""
