@@ -717,7 +717,7 @@ def mass_chains(draw) -> Turned:
     radii = draw(st.lists(st.sampled_from([0.001, 0.005, 0.01, 0.05]), min_size=n, max_size=n))
     into = _into(draw)
     if draw(st.booleans()):  # a single wall
-        keep = draw(st.integers(0, 2))
+        keep = draw(st.sampled_from(np.flatnonzero(into).tolist()))  # one of the walls it pressed
         into = np.where(np.arange(3) == keep, into, 0.0)
     positions = _pressed(draw, half, into, radii, heaps=True)
     ratio = draw(st.sampled_from([2.0, 7.0, 47.0, 100.0, 0.1]))
