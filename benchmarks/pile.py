@@ -7,7 +7,7 @@ PyBullet runs the same pile side by side when installed (pip install '.[bench]')
 
 import sys
 
-from ballpit.bench import main
+from ballpit.cli.bench import main
 
 if __name__ == "__main__":
     sys.exit(main(["--workload", "pile", *sys.argv[1:]]))

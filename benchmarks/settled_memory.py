@@ -17,7 +17,7 @@ import sys
 import tracemalloc
 
 from ballpit import bench
-from ballpit.allocator import keep_freed_memory
+from ballpit.cli.allocator import keep_freed_memory
 
 FRAME = bench.SUBSTEPS * bench.DT
 

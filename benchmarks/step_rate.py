@@ -5,7 +5,7 @@
 
 import sys
 
-from ballpit.bench import main
+from ballpit.cli.bench import main
 
 if __name__ == "__main__":
     sys.exit(main(["--workload", "free", *sys.argv[1:]]))

@@ -108,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     width, height = (int(v) for v in args.size.lower().split("x"))
 
-    from ballpit.allocator import keep_freed_memory
+    from ballpit.cli.allocator import keep_freed_memory
     from ballpit.viewer import backend
 
     keep_freed_memory()  # as `ballpit view` does

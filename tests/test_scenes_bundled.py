@@ -18,7 +18,7 @@ import pytest
 from ballpit.scene import bundled_scenes, load_scene, read_scene
 from ballpit.viewer.camera import Camera
 
-from .cli_runner import run_in_process
+from .cli.runner import run_in_process
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"

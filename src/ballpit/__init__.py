@@ -2,24 +2,25 @@
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING
-
 __version__ = "0.1.0"
 __all__ = ["Contacts", "Plane", "Sphere", "World", "__version__", "load_scene"]
 
+# Nothing is imported here, not even typing: `ballpit` (the command line's entry point, which routes
+# Ctrl+C and SIGTERM first thing) must start before anything that takes time to load.
+TYPE_CHECKING = False
 if TYPE_CHECKING:
     from .physics import Contacts, Plane, Sphere, World
     from .scene import load_scene
 
-# Imported on first use, so `import ballpit` (and with it the command line, which installs its Ctrl+C
-# and SIGTERM handlers first thing) starts before NumPy is loaded.
+# Imported on first use, so `import ballpit` loads neither NumPy nor the physics.
 _LAZY = {"Contacts": "physics", "Plane": "physics", "Sphere": "physics", "World": "physics",
          "load_scene": "scene"}  # fmt: skip
 
 
 def __getattr__(name: str):
     if name in _LAZY:
+        import importlib
+
         value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value

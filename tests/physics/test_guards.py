@@ -2,6 +2,7 @@
 gravity, plane views, huge Python integers and view indices."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -119,3 +120,95 @@ def test_a_bad_plane_value_written_after_a_restore_is_put_back_to_the_restored_v
     with pytest.raises(ValueError, match="plane #1 has a bad center"):
         world.step(0.01)
     np.testing.assert_array_equal(world.planes[1].position, centre)
+
+
+def _world_with_balls() -> ballpit.World:
+    world = ballpit.World()
+    world.add_plane()
+    world.add_spheres([[0, 1, 0], [2, 3, 0]], radius=0.5, angular_velocity=(0, 1, 0))
+    world.step(0.01)
+    return world
+
+
+def test_a_zero_quaternion_written_into_a_ball_view_is_refused_by_name_and_put_back():
+    world = _world_with_balls()
+    ball = world.spheres[1]
+    good = np.array(world.state.body)
+    ball.orientation[:] = 0.0
+    refusal = (
+        r"^sphere #1 has a zero orientation quaternion \[0.0, 0.0, 0.0, 0.0\], which cannot be normalised; "
+        r"the world was not stepped and keeps its last good state$"
+    )
+    with pytest.raises(ValueError, match=refusal):
+        world.step(0.01)
+    np.testing.assert_array_equal(world.state.body, good)
+    world.step(0.01)  # and it steps on from there, every time
+    world.step(0.01)
+    assert abs(np.linalg.norm(ball.orientation) - 1.0) < 1e-12
+
+
+@pytest.mark.parametrize(
+    ("write", "message"),
+    [
+        (lambda w: w.spheres[0].position.__setitem__(slice(None), math.nan), "non-finite position"),
+        (lambda w: w.spheres.velocities.__setitem__((1, 2), math.inf), "non-finite velocity"),
+        (
+            lambda w: w.spheres.angular_velocities.__setitem__((1, 0), 2e9),
+            "beyond 1e+09 in its angular_velocity",
+        ),
+        (lambda w: w.spheres.orientations.__setitem__((0, 3), 1e300), "too large orientation quaternion"),
+    ],
+)
+def test_a_bad_value_written_into_a_ball_view_is_put_back_as_the_last_step_left_it(write, message):
+    world = _world_with_balls()
+    good = np.array(world.state.body)
+    world.spheres[0].velocity[0] = 0.25  # a good value written beside the bad one stays
+    good[0, 3] = 0.25
+    write(world)
+    with pytest.raises(
+        ValueError, match=re.escape(message) + ".*the world was not stepped and keeps its last good state"
+    ):
+        world.step(0.01)
+    np.testing.assert_array_equal(world.state.body, good)
+    world.step(0.01)
+    assert np.isfinite(world.state.body).all()
+
+
+def test_a_bad_value_written_through_a_view_kept_from_before_the_last_step_is_refused():
+    world = _world_with_balls()
+    kept = world.spheres.positions
+    world.step(0.01)
+    kept[0, 1] = math.nan  # no copy was taken since that step: refused by name, not put back
+    with pytest.raises(
+        ValueError, match=r"^sphere #0 has a non-finite position \(nan\); the world was not stepped$"
+    ):
+        world.step(0.01)
+
+
+def test_a_ball_view_kept_from_before_a_restore_says_the_ball_is_no_longer_there():
+    world = _world_with_balls()
+    snap = world.snapshot()
+    later = world.add_sphere(position=(5, 1, 0))
+    plane = world.add_plane(position=(0, 10, 0))
+    world.restore(snap)
+    for read in (lambda: later.position, lambda: later.radius, lambda: setattr(later, "velocity", (1, 0, 0))):
+        gone = r"^sphere #2 is no longer in the world, which holds 2 balls: it was removed, or the world"
+        with pytest.raises(
+            IndexError, match=gone + r" restored to a snapshot taken before this ball was added$"
+        ):
+            read()
+    with pytest.raises(IndexError, match=r"^plane #1 is no longer in the world, which holds 1 plane: "):
+        _ = plane.normal
+    assert world.spheres[1].position[1] > 2.0  # views of balls that were there still work
+
+
+def test_a_bad_value_is_not_put_back_from_another_balls_copy_after_a_ball_is_removed():
+    world = _world_with_balls()
+    world.add_sphere(position=(4, 1, 0))
+    assert world.spheres.positions[2, 0] == 4.0  # copied now, as the views hand the positions out
+    world.remove_sphere(0)  # the rows after it move down: the copy no longer lines up
+    world.spheres[1].position[:] = math.nan
+    with pytest.raises(ValueError, match=r"^sphere #1 has a non-finite position"):
+        world.step(0.01)
+    assert world.spheres[0].position[0] == 2.0  # nothing of the removed ball's written anywhere
+    assert world.spheres[1].position.tolist() == [4.0, 1.0, 0.0]  # put back from a copy taken since

@@ -3,12 +3,14 @@
 import math
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 import ballpit
+from ballpit.physics import validation
 
 
 def test_views_read_and_write_the_world_arrays():
@@ -188,3 +190,81 @@ def test_a_nan_written_straight_into_the_arrays_is_refused_by_name_before_steppi
     with pytest.raises(ValueError, match=r"sphere #1 has a non-finite velocity"):
         world.step(0.01)
     assert world.time == 0.0
+
+
+def test_substeps_are_whole_numbers_from_one_to_a_thousand():
+    world = ballpit.World(substeps=1000)
+    assert world.substeps == 1000
+    for bad in (10**12, 1001, 0, 2.0, True):
+        with pytest.raises(
+            ValueError, match=rf"substeps must be a whole number from 1 to 1,000, got {bad!r}"
+        ):
+            ballpit.World(substeps=bad)
+        with pytest.raises(ValueError, match="substeps"):
+            world.substeps = bad
+    assert world.substeps == 1000
+
+
+def test_a_restitution_above_one_is_refused_for_balls_and_planes_alike():
+    # e = 1 is elastic; more would be a ball leaving faster than it came, which the step never lets an
+    # impact do (it keeps every impact from adding energy), so it is refused rather than held to 1.
+    world = ballpit.World()
+    ball = world.add_sphere(position=(0, 1, 0), restitution=1.0)
+    plane = world.add_plane(restitution=1.0)
+    for call in (
+        lambda: world.add_sphere(restitution=2),
+        lambda: world.add_spheres([[0, 3, 0], [0, 5, 0]], restitution=[0.5, 1.5]),
+        lambda: world.add_plane(restitution=1.01),
+        lambda: setattr(ball, "restitution", 2.0),
+        lambda: setattr(plane, "restitution", 2.0),
+    ):
+        with pytest.raises(ValueError, match=r"restitution must be from 0 to 1, got"):
+            call()
+    assert (ball.restitution, plane.restitution, len(world.spheres), len(world.planes)) == (1.0, 1.0, 1, 1)
+    world.planes.restitutions[0] = 2.0  # written straight into the column: refused by the step, put back
+    with pytest.raises(ValueError, match=r"plane #0 has a bad restitution 2.0: it must be from 0 to 1"):
+        world.step(0.01)
+    assert plane.restitution == 1.0
+
+
+def test_a_step_longer_than_a_billion_seconds_is_refused_by_name_without_a_warning():
+    world = ballpit.World()
+    world.add_plane()
+    world.add_sphere(position=(0, 1, 0))
+    body = world.state.body.copy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an overflow warning on the way would raise here
+        with pytest.raises(ValueError, match=r"^dt must be at most 1e\+09 s, got 1e\+308$"):
+            world.step(1e308)
+    assert world.time == 0.0
+    np.testing.assert_array_equal(world.state.body, body)
+
+
+def test_planes_added_one_by_one_are_copied_once_not_once_a_plane(monkeypatch):
+    # Adding a plane copied every plane's columns (40,000 planes took 18.7 s to load); now it appends
+    # its own row to the copy a step puts bad values back from.
+    copies = []
+    real = validation.planes_as_stepped
+    monkeypatch.setattr(validation, "planes_as_stepped", lambda *a: copies.append(1) or real(*a))
+    world = ballpit.World()
+    for k in range(100):
+        world.add_plane(position=(0, -k, 0))
+    assert len(copies) <= 1
+
+
+def test_planes_added_after_a_step_are_put_back_like_the_others():
+    world = ballpit.World()
+    world.add_plane()
+    world.add_sphere(position=(0, 1, 0))
+    world.step(0.01)
+    for k in range(1, 4):
+        world.add_plane(position=(0, 0, -k), normal=(0, 0, 1), size=(2.0, 1.0 + k))
+    good = {name: np.array(getattr(world.planes, name)) for name in ("centers", "normals", "half_sizes")}
+    world.planes.centers[0, 1] = math.nan
+    world.planes.normals[2] = (0.0, 0.0, 0.0)
+    world.planes.half_sizes[3, 1] = -1.0
+    with pytest.raises(ValueError, match=r"^plane #0 has a bad center"):
+        world.step(0.01)
+    for name, values in good.items():
+        np.testing.assert_array_equal(getattr(world.planes, name), values)
+    world.step(0.01)

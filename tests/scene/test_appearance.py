@@ -47,7 +47,7 @@ def test_default_colours_are_the_palette_and_the_restitution_ramp():
     world = ballpit.World()
     world.add_plane()
     world.add_plane(position=(0, 1, 0), size=2.0, restitution=0.0)
-    world.add_plane(position=(0, 3, 0), size=2.0, restitution=1.5)
+    world.add_plane(position=(0, 3, 0), size=2.0, restitution=1.0)
     world.add_spheres(np.arange(12)[:, None] * [1.0, 0, 0] + [0, 6, 0], radius=0.3)
     look = default_appearance(world)
     assert np.array_equal(look.sphere_colors[0], hex_to_rgb(PALETTE[0]))
@@ -55,7 +55,7 @@ def test_default_colours_are_the_palette_and_the_restitution_ramp():
     assert len({tuple(c) for c in look.sphere_colors[: len(PALETTE)]}) == len(PALETTE)
     assert np.array_equal(look.plane_colors[0], GROUND_COLOR)
     assert np.allclose(look.plane_colors[1], [0.29, 0.36, 0.50])  # dead: slate blue
-    assert np.allclose(look.plane_colors[2], [0.93, 0.55, 0.20])  # bouncy (clipped at 1): orange
+    assert np.allclose(look.plane_colors[2], [0.93, 0.55, 0.20])  # elastic: orange
     assert np.allclose(restitution_colors([0.5]), [[0.30, 0.56, 0.42]])
     assert np.array_equal(plane_colors([0.5, 0.5], [True, False])[0], GROUND_COLOR)
 

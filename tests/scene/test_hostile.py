@@ -3,6 +3,7 @@ traceback, from both ``ballpit check`` and ``ballpit simulate``; none hangs or r
 
 from __future__ import annotations
 
+import codecs
 import os
 import subprocess
 import sys
@@ -12,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit.scene import read_scene
+from ballpit.scene import read_scene, schema
 from ballpit.scene.lines import LineIndex
 
 from .helpers import refused, run_cli
@@ -111,6 +112,45 @@ def test_the_largest_and_smallest_numbers_still_load(tmp_path):
     assert code == 0 and lines == []
 
 
+def test_substeps_beyond_the_physics_bound_are_refused(tmp_path):
+    # 10⁹ substeps passed 'ballpit check' and would take days a step; World takes at most 1,000.
+    refused(
+        scene(tmp_path, "[world]\nsubsteps = 1000000000\n"),
+        ":2: [world]: key 'substeps': must be at most 1,000",
+    )
+    refused(scene(tmp_path, "[world]\nsubsteps = 1001\n"), "must be at most 1,000, got 1001")
+    assert read_scene(scene(tmp_path, "[world]\nsubsteps = 1000\n")).world.substeps == 1000
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "[[sphere]]\nposition = [0, 1, 0]\nrestitution = 2\n",
+        "[[grid]]\ncorner = [0, 1, 0]\ncount = [2, 1, 1]\nrestitution = 1.5\n",
+        "[[plane]]\nrestitution = 1.01\n",
+    ],
+)
+def test_a_restitution_above_one_is_refused_as_the_world_refuses_it(tmp_path, text):
+    refused(scene(tmp_path, text), "key 'restitution': must be between 0 and 1, got ")
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        (
+            "[[sphere]]\nposition = [1" + "0" * 400 + ", 0, 0]\n",
+            "key 'position': components must be between -1e9",
+        ),
+        ("[[sphere]]\nposition = [0, 1, 0]\nradius = 1" + "0" * 400 + "\n", "must be between 1e-9 and 1e9"),
+        ("[world]\nlinear_drag = -1" + "0" * 400 + "\n", "key 'linear_drag': must be between 0 and 1e9"),
+        ("[[plane]]\nsize = [1" + "0" * 400 + ", 1]\n", "key 'size': must be between 1e-9 and 1e9"),
+        ("[[sphere]]\nposition = [0, 1, 0]\ncolor = [1" + "0" * 400 + ", 0, 0]\n", "between 0 and 1"),
+    ],
+)
+def test_an_integer_too_large_for_a_float_is_refused_by_name(tmp_path, text, fragment):
+    refused(scene(tmp_path, text), fragment)
+
+
 # ---------------------------------------------------------------------------------------- files
 
 
@@ -176,6 +216,72 @@ def test_forty_thousand_sphere_tables_check_in_linear_time(tmp_path):
     assert np.array_equal(scene_.world.spheres.positions[-1], [79_998, 1, 0])
 
 
+def test_more_planes_than_a_scene_may_have_are_refused_before_any_is_read(tmp_path, monkeypatch):
+    assert schema.MAX_PLANES == 100_000
+    monkeypatch.setattr(schema, "MAX_PLANES", 3)
+    text = "[[plane]]\nposition = [0, 0, 0]\n" * 3 + "[[plane]]\nposition = [0, nan, 0]\n"
+    refused(scene(tmp_path, text), ":7: plane #4: 4 of them are more than the 3 a scene may have")
+
+
+def test_more_spheres_than_a_scene_may_have_are_refused_before_any_is_read(tmp_path, monkeypatch):
+    monkeypatch.setattr(schema, "MAX_BALLS", 2)
+    text = "[[sphere]]\nposition = [0, 0, 0]\n" * 3
+    refused(scene(tmp_path, text), ":5: sphere #3: 3 of them are more than the 2 a scene may have")
+
+
+def _peak_rss_of_reading(path: Path) -> tuple[str, int]:
+    """Read the scene in a process of its own: (what it said, its peak resident memory in bytes)."""
+    code = (
+        "import sys\n"
+        "from ballpit.scene import read_scene\n"
+        "try:\n"
+        "    print(len(read_scene(sys.argv[1]).world.spheres))\n"
+        "except ValueError as e:\n"
+        "    print(e)\n"
+        "print(int(next(l for l in open('/proc/self/status') if l.startswith('VmHWM')).split()[1]))\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=600)
+    said, peak = r.stdout.strip().splitlines()
+    return said, int(peak) * 1024  # VmHWM: this process's own peak, in KiB (ru_maxrss can carry the
+    # parent's, forked before the exec)
+
+
+HALF_A_MILLION = 450_977  # 15 MiB of [[sphere]] tables, as the attack had them
+
+
+def _many_spheres(path: Path, bad_last: bool) -> Path:
+    with open(path, "w") as f:
+        for k in range(HALF_A_MILLION):
+            f.write(f"[[sphere]]\nposition=[{k % 80 * 2},{k // 80 % 80 * 2},{k // 6400 * 2}]\n")
+        if bad_last:
+            f.write("[[sphere]]\nposition=[nan,1,1]\n")
+    return path
+
+
+@pytest.mark.slow
+def test_half_a_million_spheres_with_a_nan_at_the_end_are_refused_within_500_mb(tmp_path):
+    # It took 1.36 GB: every parsed table, a Python object per value and the whole line index were kept.
+    said, peak = _peak_rss_of_reading(_many_spheres(tmp_path / "bad.toml", bad_last=True))
+    assert said.endswith(f"sphere #{HALF_A_MILLION + 1}: key 'position': must be finite, got [nan, 1, 1]")
+    assert peak < 500e6, f"{peak / 1e6:.0f} MB"
+
+
+@pytest.mark.slow
+def test_half_a_million_spheres_load_within_500_mb(tmp_path):
+    said, peak = _peak_rss_of_reading(_many_spheres(tmp_path / "good.toml", bad_last=False))
+    assert said == str(HALF_A_MILLION)
+    assert peak < 500e6, f"{peak / 1e6:.0f} MB"
+
+
+@pytest.mark.slow
+def test_a_million_ball_grid_loads_within_500_mb(tmp_path):
+    # The start-overlap check listed every candidate pair at once: 1.2 GB for these 60 bytes.
+    path = scene(tmp_path, "[[grid]]\ncount = [100, 100, 100]\ncorner = [0, 1, 0]\nradius = 0.1\n")
+    said, peak = _peak_rss_of_reading(path)
+    assert said == "1000000"
+    assert peak < 500e6, f"{peak / 1e6:.0f} MB"
+
+
 # ---------------------------------------------------------------------------------------- line index
 
 LONG_LINES = {
@@ -211,6 +317,21 @@ def test_header_and_key_lines_still_found():
     assert first.header_line == 3 and first.key_lines == {"quoted.key": 4}
     assert second.header_line == 5 and second.key_lines == {"a": 6}
     assert index.table("x.y.z").header_line == 7 and index.table("x.y.z").key_lines == {"k": 8}
+
+
+def test_a_utf8_byte_order_mark_is_skipped(tmp_path):
+    path = tmp_path / "notepad.toml"
+    path.write_bytes(codecs.BOM_UTF8 + b"[[sphere]]\nposition = [0, 1, 0]\nradius = 0.25\n")
+    assert read_scene(path).world.spheres[0].radius == 0.25
+    path.write_bytes(codecs.BOM_UTF8 + b"[[sphere]]\nradius = -1\n")
+    refused(path, ":1: sphere #1: missing required key 'position'")  # lines are counted as before
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-32"])
+def test_a_utf16_or_utf32_file_is_refused_naming_its_byte_order_mark(tmp_path, encoding):
+    path = tmp_path / "wide.toml"
+    path.write_bytes("[[sphere]]\nposition = [0, 1, 0]\n".encode(encoding))  # with its byte-order mark
+    refused(path, ":1: starts with a UTF-16 byte-order mark: save it as UTF-8 text")
 
 
 # ---------------------------------------------------------------------------------------- messages

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.scene import overlap
 from ballpit.scene.overlap import first_overlap, first_plane_cut
 
 
@@ -83,3 +84,22 @@ def test_plane_cuts_are_found_on_faces_edges_and_not_beyond_a_square():
     p, k, dist = first_plane_cut(positions, radii, world.planes, 1e-6)
     assert (p, k) == (0, 1) and dist == pytest.approx(np.hypot(0.2, 0.1))
     assert first_plane_cut(positions[[0, 3]], radii[[0, 3]], world.planes, 1e-6) is None
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_checked_in_slabs_the_first_overlap_is_still_the_brute_force_first_pair(seed, monkeypatch):
+    # A million-ball grid is checked a slab at a time (its pair lists took 1 GB at once): every pair
+    # that overlaps must still be seen, whichever slabs its two balls fall in.
+    monkeypatch.setattr(overlap, "SLAB", 40)
+    rng = np.random.default_rng(seed)
+    shape = (12, 8, 6) if seed % 2 else (200, 2, 1)  # a block, or a long row
+    positions = np.indices(shape).reshape(3, -1).T * 1.0 + rng.uniform(-0.05, 0.05, (int(np.prod(shape)), 3))
+    radii = np.full(len(positions), 0.3)
+    movers = rng.choice(len(positions), size=3, replace=False)
+    targets = rng.choice(len(positions), size=3, replace=False)
+    positions[movers] = positions[targets] + rng.uniform(-0.4, 0.4, (3, 3))  # a few overlaps, anywhere
+    if seed % 4 == 3:
+        radii[rng.integers(len(radii))] = 3.0  # one ball reaching across many slabs
+    expected = brute_force(positions, radii, 0.0)
+    assert expected is not None
+    assert first_overlap(positions, radii, 0.0) == expected

@@ -173,7 +173,7 @@ def ghosts_and_plot(workdir: Path) -> dict:
 
 
 def replay(workdir: Path) -> dict:
-    from ballpit.viewer.replay import read_trajectory
+    from ballpit.cli.trajectory import read_trajectory
 
     scene = Path(sys.argv[3])
     trajectory = read_trajectory(workdir / sys.argv[4])
@@ -216,7 +216,7 @@ def replay(workdir: Path) -> dict:
 def replay_refuses_reaching_in(workdir: Path) -> dict:
     """B (a real X key press) and a real pointer drag on a ball, in a replay: each is refused with a
     message, and the replay plays on frame by frame as recorded."""
-    from ballpit.viewer.replay import read_trajectory
+    from ballpit.cli.trajectory import read_trajectory
 
     scene = Path(sys.argv[3])
     trajectory = read_trajectory(workdir / sys.argv[4])

@@ -78,7 +78,8 @@ def test_a_ball_edit_mid_run_changes_the_next_bounce_to_e_squared_h_and_the_hist
         ("radius", -0.1, "radius must be positive, got -0.1"),
         ("radius", math.nan, "radius must be finite, got nan"),
         ("mass", 0.0, "mass must be positive, got 0.0"),
-        ("restitution", -1.0, "restitution must not be negative, got -1.0"),
+        ("restitution", -1.0, "restitution must be from 0 to 1, got -1.0"),
+        ("restitution", 2.0, "restitution must be from 0 to 1, got 2.0"),
         ("velocity", (0.0, math.nan, 0.0), "velocity must be finite"),
     ],
 )
@@ -117,7 +118,7 @@ def test_world_settings_apply_at_once_and_stay_through_a_reset_the_timestep_rese
     edits.world("timestep", 1 / 120)
     assert sim.timestep == 1 / 120 and sim.phase is Phase.WAITING and sim.world.time == 0.0
     edits.world("substeps", 0)
-    assert edits.error("world.substeps") == "substeps must be a whole number of at least 1, got 0"
+    assert edits.error("world.substeps") == "substeps must be a whole number from 1 to 1,000, got 0"
     edits.world("gravity", (0, "a", 0))
     assert "gravity" in edits.error("world.gravity")
     assert sim.world.substeps == 4 and sim.world.gravity[1] == -1.62
@@ -212,8 +213,7 @@ def test_the_orbit_camera_turns_about_its_target_zooms_towards_it_and_pans_with_
 
 
 def test_a_replay_refuses_edits_and_plays_on(tmp_path):
-    from ballpit.viewer.replay import read_trajectory
-    from ballpit.writers import TrajectoryWriter
+    from ballpit.cli.trajectory import TrajectoryWriter, read_trajectory
 
     sim = bounce_sim()
     out = tmp_path / "run.npz"

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ballpit.cli.trajectory import TRAJECTORY_COLUMNS
 from ballpit.scene import default_scene_path, read_scene
-from ballpit.writers import TRAJECTORY_COLUMNS
 
 from .conftest import subprocess_env
 from .test_reach import run_scenario
@@ -179,8 +179,8 @@ def test_the_close_button_writes_the_record_and_a_reset_starts_the_timeline_agai
     assert len(times) - 1 == r["steps_since_reset"]
     live = read_scene(tmp_path / "live.toml")
     world = live.world
-    from ballpit.simulate import run
-    from ballpit.writers import TrajectoryWriter
+    from ballpit.cli.simulate import run
+    from ballpit.cli.trajectory import TrajectoryWriter
 
     writer = TrajectoryWriter(tmp_path / "sim.npz", len(world.spheres))
     run(world, r["steps_since_reset"] * live.timestep, dt=live.timestep, trajectory=writer)

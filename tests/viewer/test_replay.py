@@ -1,8 +1,10 @@
 """Reading trajectories for ``view --replay``: what simulate writes reads back exactly; what does not fit
-the scene is a one-line error naming the file, exit status 2, before any window opens."""
+the scene is a one-line error naming the file, exit status 2, before any window opens; a record made
+after B added a ball replays, the added ball from the frame it appears in."""
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -11,11 +13,14 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.cli.trajectory import TrajectoryError, read_trajectory
 from ballpit.scene import read_scene
-from ballpit.viewer.replay import Replay, TrajectoryError, read_trajectory
+from ballpit.viewer.recording import Recorder
+from ballpit.viewer.replay import Replay
+from ballpit.viewer.simulation import Simulation
 
-from ..test_cli import assert_user_error
-from ..test_cli import ballpit as run_ballpit
+from ..cli.test_commands import assert_user_error
+from ..cli.test_commands import ballpit as run_ballpit
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
@@ -105,3 +110,57 @@ def test_trajectories_that_do_not_fit_are_one_line_errors_with_status_2(tmp_path
 def test_replay_is_in_the_view_help():
     r = subprocess.run([sys.executable, "-m", "ballpit", "view", "--help"], capture_output=True, text=True)
     assert "--replay" in r.stdout
+
+
+SLOPES = SCENES / "slopes.toml"
+
+
+def _record_with_a_shot(path: Path) -> tuple[Simulation, int]:
+    """slopes.toml recorded in the viewer's way: 20 steps, a ball shot in (what B does), 20 more."""
+    sim = Simulation(read_scene(SLOPES), SLOPES, step_budget=math.inf)
+    recorder = Recorder(path, sim)
+    sim.start()
+    dt = sim.timestep
+    sim.advance(20 * dt + 1e-9)
+    shot = sim.add_ball((1.0, 0.0, 0.0), position=(0.0, 6.0, 2.0), radius=0.2, velocity=(0.0, 0.0, -3.0))
+    sim.advance(20 * dt + 1e-9)
+    recorder.finish()
+    return sim, shot
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".csv"])
+def test_a_record_made_after_a_ball_was_shot_in_replays(tmp_path, suffix):
+    path = tmp_path / f"run{suffix}"
+    live, shot = _record_with_a_shot(path)
+    t = read_trajectory(path, n_balls=5)
+    assert t.frames == 41 and t.balls == 6
+    assert t.balls_at(0) == 5 and t.balls_at(20) == 5 and t.balls_at(21) == 6 and t.balls_at(40) == 6
+    assert np.isnan(t.position[20, 5]).all()  # not there yet
+    rtol = 0 if suffix == ".npz" else 1e-8
+    np.testing.assert_allclose(t.position[40], live.world.spheres.positions, rtol=rtol, atol=1e-12)
+
+    sim = Simulation(read_scene(SLOPES), SLOPES, trajectory=t)
+    assert sim.error is None and sim.ball_count == 5
+    assert len(sim.appearance.sphere_colors) == 6  # a colour for the added ball, as B gives it
+    sim.start()
+    sim.advance(30 * sim.timestep)  # plays on past the frame the ball appears in
+    assert sim.ball_count == 6 and len(sim.prev_positions) == 6
+    current = sim.timeline.replay.current
+    np.testing.assert_allclose(sim.world.spheres.positions, t.position[current], rtol=rtol, atol=1e-12)
+    assert sim.world.spheres[shot].radius == pytest.approx(np.median(read_scene(SLOPES).world.spheres.radii))
+    sim.toggle_pause()
+    sim.scrub(0.0)  # back before the shot: the scene's five balls again
+    assert sim.ball_count == 5 and len(sim.trails.ordered()[0]) == 5
+    np.testing.assert_array_equal(sim.world.spheres.positions, t.position[0, :5])
+
+
+def test_replay_seek_outside_the_added_balls_keeps_the_scene_balls(tmp_path):
+    path = tmp_path / "run.csv"
+    _record_with_a_shot(path)
+    world = read_scene(SLOPES).world
+    t = read_trajectory(path)
+    r = Replay(world, t)
+    for frame in (40, 3, 25, 0):
+        r.seek(frame)
+        assert len(world.spheres) == t.balls_at(frame)
+        np.testing.assert_array_equal(world.spheres.positions, t.position[frame, : t.balls_at(frame)])

@@ -3,6 +3,7 @@ and loads back (``ballpit check`` too) into the same World as the one saved."""
 
 from __future__ import annotations
 
+import codecs
 import re
 import subprocess
 import sys
@@ -273,3 +274,12 @@ def test_a_world_built_in_code_says_so_when_saved():
     world.add_plane(position=(0, 0, 0))
     text = scene_text(Simulation(world), Camera(), now=datetime(2026, 12, 2, 9, 30, 5))
     assert text.startswith(SAVED_MARK + "a world built in code") and "original's" not in text
+
+
+def test_a_scene_starting_with_a_byte_order_mark_saves_with_its_comments(tmp_path):
+    path = tmp_path / "notepad.toml"
+    path.write_bytes(codecs.BOM_UTF8 + SCENE.encode())
+    sim = Simulation(read_scene(path), path)
+    saved = save_scene(sim, Camera.looking_at((1.0, 2.0, 8.0), (0.0, 1.0, 0.0)))
+    assert "# A test scene: a ramp, a ball and a grid." in saved.read_text()
+    assert_same_world(read_scene(saved).world, sim.world)

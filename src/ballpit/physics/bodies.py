@@ -25,6 +25,7 @@ class World(Protocol):
 
     model: Model
     state: State
+    _good_balls: validation.LastGoodBalls
 
 
 _LIMITS = {
@@ -34,32 +35,45 @@ _LIMITS = {
 }
 
 
+def _handed_out(world: World, field: slice) -> np.ndarray:
+    """The ball state block, whose ``field`` columns are about to be handed out as a view: a bad value
+    written through it is put back as the last step left it (``validation.LastGoodBalls``)."""
+    body = world.state.body
+    world._good_balls.expose(body, field)
+    return body
+
+
 def _state_vector(cols: slice, name: str, length: int):
     def get(self: Sphere) -> np.ndarray:
-        return self._world.state.body[self.index, cols]
+        row = self.row
+        return _handed_out(self._world, cols)[row, cols]
 
     def set(self: Sphere, value: object) -> None:
         if name == "orientation":
             vec = validation.quaternion(name, value)
         else:
             vec = validation.vector(name, value, length, limit=_LIMITS[name])
-        self._world.state.body[self.index, cols] = vec
+        self._world.state.body[self.row, cols] = vec
 
     return property(get, set, doc=f"The ball's {name.replace('_', ' ')} (world frame).")
 
 
 def _material(name: str, owner: str):
     def get(self) -> float:
-        return float(getattr(self._columns, name)[self.index])
+        return float(getattr(self._columns, name)[self.row])
 
     def set(self, value: object) -> None:
-        getattr(self._columns, name)[self.index] = validation.number(name, value, nonnegative=True)
+        if name == "restitution":
+            checked = validation.number(name, value, within=validation.RESTITUTION_RANGE)
+        else:
+            checked = validation.number(name, value, nonnegative=True)
+        getattr(self._columns, name)[self.row] = checked
 
     return property(get, set, doc=f"The {owner}'s {name.replace('_', ' ')} coefficient.")
 
 
 def _state_column(cols: slice, doc: str) -> property:
-    return property(lambda self: self._world.state.body[:, cols], doc=doc)
+    return property(lambda self: _handed_out(self._world, cols)[:, cols], doc=doc)
 
 
 def _plane_column(name: str, doc: str, pose: bool = False) -> property:
@@ -71,11 +85,11 @@ def _plane_column(name: str, doc: str, pose: bool = False) -> property:
 
 def _plane_motion(name: str, doc: str) -> property:
     def get(self: Plane) -> np.ndarray:
-        return getattr(self._columns, name)[self.index]
+        return getattr(self._columns, name)[self.row]
 
     def set(self: Plane, value: object) -> None:
         limit = validation.MAX_SPEED if name == "velocity" else validation.MAX_SPIN
-        getattr(self._columns, name)[self.index] = validation.vector(name, value, limit=limit)
+        getattr(self._columns, name)[self.row] = validation.vector(name, value, limit=limit)
 
     return property(get, set, doc=doc)
 
@@ -84,16 +98,37 @@ class _Body:
     """A live view: the world and a row index, nothing else, so it never goes stale."""
 
     __slots__ = ("_world", "index")
+    _kind = _noun = "body"
 
     def __init__(self, world: World, index: int) -> None:
         self._world = world
         self.index = index
+
+    def _count(self) -> int:
+        raise NotImplementedError
+
+    @property
+    def row(self) -> int:
+        """``index``, once it is checked that the world still has this body: one removed, or a world
+        restored to a snapshot taken before the body was added, has not (IndexError, saying so)."""
+        n = self._count()
+        if self.index >= n:
+            noun = self._noun if n == 1 else f"{self._noun}s"
+            raise IndexError(
+                f"{self._kind} #{self.index} is no longer in the world, which holds {n} {noun}: it was "
+                f"removed, or the world restored to a snapshot taken before this {self._noun} was added"
+            )
+        return self.index
 
 
 class Sphere(_Body):
     """A ball: a live view of row ``index`` of the world's sphere arrays."""
 
     __slots__ = ()
+    _kind, _noun = "sphere", "ball"
+
+    def _count(self) -> int:
+        return self._world.state.count
 
     @property
     def _columns(self) -> Columns:
@@ -109,20 +144,20 @@ class Sphere(_Body):
 
     @property
     def radius(self) -> float:
-        return float(self._columns.radius[self.index])
+        return float(self._columns.radius[self.row])
 
     @property
     def mass(self) -> float:
-        return float(self._columns.mass[self.index])
+        return float(self._columns.mass[self.row])
 
     @property
     def hollow(self) -> bool:
-        return bool(self._columns.hollow[self.index])
+        return bool(self._columns.hollow[self.row])
 
     @property
     def inertia(self) -> float:
         """Moment of inertia about any axis through the centre: 2/5·m·r² solid, 2/3·m·r² hollow."""
-        return 1.0 / float(self._columns.inv_inertia[self.index])
+        return 1.0 / float(self._columns.inv_inertia[self.row])
 
     def __repr__(self) -> str:
         x, y, z = self.position
@@ -133,6 +168,10 @@ class Plane(_Body):
     """A plane or finite rectangle: a live view of row ``index`` of the world's plane arrays."""
 
     __slots__ = ()
+    _kind = _noun = "plane"
+
+    def _count(self) -> int:
+        return self._world.model.planes.count
 
     @property
     def _columns(self) -> Columns:
@@ -155,37 +194,38 @@ class Plane(_Body):
     @property
     def position(self) -> np.ndarray:
         """Where the plane's centre is now (a step moves it by its velocity)."""
-        return self._pose.center[self.index]
+        return self._pose.center[self.row]
 
     @property
     def normal(self) -> np.ndarray:
-        return self._pose.normal[self.index]
+        return self._pose.normal[self.row]
 
     @property
     def orientation(self) -> np.ndarray:
         """The rotation taking the +y plane to this one, (x, y, z, w)."""
-        return self._pose.orientation[self.index]
+        return self._pose.orientation[self.row]
 
     @property
     def axes(self) -> tuple[np.ndarray, np.ndarray]:
         """The in-plane width (+x turned) and depth (+z turned) directions."""
-        return self._pose.axis_u[self.index], self._pose.axis_v[self.index]
+        i = self.row
+        return self._pose.axis_u[i], self._pose.axis_v[i]
 
     @property
     def size(self) -> tuple[float, float] | None:
         """(width, depth) in metres, or None for an infinite plane."""
-        half = self._columns.half_size[self.index]
+        half = self._columns.half_size[self.row]
         if np.isinf(half).all():
             return None
         return float(2 * half[0]), float(2 * half[1])
 
     @property
     def infinite(self) -> bool:
-        return bool(np.isinf(self._columns.half_size[self.index]).all())
+        return bool(np.isinf(self._columns.half_size[self.row]).all())
 
     def _frame(self) -> tuple[np.ndarray, ...]:
         pose = self._pose
-        i = slice(self.index, self.index + 1)
+        i = slice(self.row, self.row + 1)
         return pose.center[i], pose.normal[i], pose.axis_u[i], pose.axis_v[i], self._columns.half_size[i]
 
     def signed_distance(self, points: object) -> np.ndarray | float:

@@ -9,6 +9,7 @@ import numpy as np
 
 from . import exact
 from . import quaternion as rotations
+from .state import Q
 
 # What the engine can step: far enough inside float64 that squares, products and sums of these never
 # overflow or underflow (a speed of 1e154 m/s once overflowed v² in the time of impact and hung a step).
@@ -24,6 +25,18 @@ MAX_GRAVITY = 1e9
 # A Python int too large for a float (10**400) is named so, not shown: its repr may be thousands of digits.
 TOO_LARGE = "an integer too large for a float"
 UNIT_TOLERANCE = 1e-6  # how far a plane's normal, axes or orientation may be from unit length
+# The longest step (s): the same bound as every other number. Positions, speeds and accelerations within
+# theirs then stay far from overflow through a step's squares and products (a step of 1e100 s overflowed
+# a·h² and printed warnings before the step was undone); a step this long is a mistake, not a run.
+MAX_TIMESTEP = 1e9
+# Soft substeps per crowded step: as many as a split step may have intervals (settings.MAX_INTERVALS). A
+# frame tried again takes up to four times as many; a step divided finer than this is a smaller
+# timestep's job, and 10⁹ substeps (which a scene once asked for) would take days a step.
+MAX_SUBSTEPS = 1_000
+# A coefficient of restitution, a ball's or a plane's: from 0 (dead) to 1 (elastic). More would be a ball
+# that leaves faster than it came, and the step keeps no impact from adding energy (impacts.py): it would
+# be held to 1 without a word, so it is refused instead.
+RESTITUTION_RANGE = (0.0, 1.0)
 
 
 def vector(name: str, value: object, length: int = 3, limit: float = math.inf) -> np.ndarray:
@@ -70,6 +83,27 @@ def number(
         raise ValueError(f"{name} must not be negative, got {value!r}")
     if within is not None and not within[0] <= x <= within[1]:
         raise ValueError(f"{name} must be from {within[0]:g} to {within[1]:g}, got {value!r}")
+    return x
+
+
+def whole_number(name: str, value: object, low: int, high: int | None = None) -> int:
+    """An int (a NumPy integer too, never a bool) from ``low`` to ``high``, or ValueError naming ``name``."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | np.integer)
+        or value < low
+        or (high is not None and value > high)
+    ):
+        bound = f"of at least {low}" if high is None else f"from {low} to {high:,}"
+        raise ValueError(f"{name} must be a whole number {bound}, got {value!r}")
+    return int(value)
+
+
+def timestep(dt: object) -> float:
+    """A step's length (s): positive and at most ``MAX_TIMESTEP``."""
+    x = number("dt", dt, positive=True)
+    if x > MAX_TIMESTEP:
+        raise ValueError(f"dt must be at most {MAX_TIMESTEP:g} s, got {dt!r}")
     return x
 
 
@@ -155,12 +189,120 @@ _STATE_LIMITS = np.concatenate([np.full(stop - start, lim) for _, start, stop, l
 _SMALLEST_LIMIT = float(_STATE_LIMITS.min())
 
 
-def reject_unsteppable_state(body: np.ndarray) -> None:
+# A ball's orientation may have any length a step can normalise (every step does): not one whose squared
+# length underflows to nothing (a zero quaternion) or overflows.
+_SHORTEST_TURN2 = 1e-24
+
+
+class LastGoodBalls:
+    """Each field of the balls' state (position, velocity, orientation, spin) as the last step left it,
+    copied when a view first hands that field out after a step: what a bad value written through a
+    view is put back to.
+
+    A copy every step would cost a pass over every ball (2 % of a 100,000-ball free fall); copied only
+    when handed out, a field costs a step nothing unless someone looks at it. While orientations are
+    out, the next step also checks that each can be normalised (a zero quaternion cannot), which it
+    otherwise leaves to its own normalising. A value written through a view kept from before the last
+    step is refused by name but cannot be put back: no copy was taken for it.
+    """
+
+    def __init__(self) -> None:
+        self._copies: dict[int, np.ndarray] = {}  # by a field's first column: its copy, rows to spare
+        self._out: dict[int, slice] = {}  # the fields handed out since the last step
+        self.count = 0  # the balls each copy holds
+
+    @property
+    def exposed(self) -> bool:
+        return bool(self._out)
+
+    def expose(self, body: np.ndarray, field: slice) -> None:
+        """``body[:, field]`` is being handed out: copy it first, once between two steps."""
+        if not self._out:
+            self.count = len(body)
+        if field.start not in self._out:
+            self._out[field.start] = field
+            self._copy(body, field, 0)
+        self.grow(body)
+
+    def grow(self, body: np.ndarray) -> None:
+        """Copy the rows of balls added since the copies were taken (checked as they were added)."""
+        if not self._out or len(body) <= self.count:
+            return
+        for field in self._out.values():
+            self._copy(body, field, self.count)
+        self.count = len(body)
+
+    def _copy(self, body: np.ndarray, field: slice, start: int) -> None:
+        """Copy rows ``start``.. of ``body[:, field]``, growing its copy (doubling) to hold them."""
+        copy = self._copies.get(field.start)
+        if copy is None or len(copy) < len(body):
+            grown = np.empty(
+                (max(len(body), 2 * (0 if copy is None else len(copy))), field.stop - field.start)
+            )
+            if copy is not None:
+                grown[:start] = copy[:start]
+            self._copies[field.start] = copy = grown
+        copy[start : len(body)] = body[start:, field]
+
+    def forget(self) -> None:
+        """The state changes from here without a view (a step, a restore): the copies are out of date."""
+        self._out.clear()
+
+    @property
+    def orientations_out(self) -> bool:
+        return Q.start in self._out
+
+    def put_back(self, body: np.ndarray) -> bool:
+        """Put every value a step cannot use back as the copies have it; True when none is left."""
+        n = min(len(body), self.count)
+        bad = _unusable(body[:n])
+        for field in self._out.values():
+            part, good, wrong = body[:n, field], self._copies[field.start][:n], bad[:, field]
+            part[wrong] = good[wrong]
+        return _unsteppable(body) is None and _unturnable(body) is None
+
+
+def _unusable(body: np.ndarray) -> np.ndarray:
+    """A mask of the entries a step cannot use: beyond their limits, non-finite, or in an orientation
+    that cannot be normalised."""
+    bad = ~(np.abs(body) <= _STATE_LIMITS)
+    bad[:, Q] |= ~_turnable(body)[:, None]
+    return bad
+
+
+def _turnable(body: np.ndarray) -> np.ndarray:
+    """Which balls' orientations a step can normalise."""
+    q = body[:, Q]
+    with np.errstate(over="ignore"):  # a square that overflows is what this looks for
+        q2 = q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] + q[:, 2] * q[:, 2] + q[:, 3] * q[:, 3]
+    return (q2 >= _SHORTEST_TURN2) & (q2 < math.inf)
+
+
+def _unturnable(body: np.ndarray) -> str | None:
+    """The first ball whose orientation cannot be normalised, with what is wrong, or None."""
+    bad = np.flatnonzero(~_turnable(body))
+    if len(bad) == 0:
+        return None
+    row = int(bad[0])
+    q = body[row, Q]
+    what = "a zero" if np.abs(q).max() < 1.0 else "a too large"  # NaN is named by _unsteppable first
+    return f"{row} has {what} orientation quaternion {q.tolist()}, which cannot be normalised"
+
+
+def reject_unsteppable_state(body: np.ndarray, last_good: LastGoodBalls | None = None) -> None:
     """Refuse to step from a NaN/inf, or a value beyond what the engine can step, written straight
-    into the arrays (the setters check theirs)."""
-    bad = _unsteppable(body)
-    if bad is not None:
-        raise ValueError(f"sphere #{bad}; the world was not stepped")
+    into the arrays (the setters check theirs); while ``last_good`` has the orientations handed out,
+    from one that cannot be normalised too. Every bad value is put back as ``last_good`` copied it,
+    so the world keeps its last good state, as with planes (``reject_bad_planes``)."""
+    exposed = last_good is not None and last_good.exposed
+    turned = last_good is not None and last_good.orientations_out
+    bad = _unsteppable(body) or (_unturnable(body) if turned else None)
+    if bad is None:
+        if last_good is not None:
+            last_good.forget()  # the step changes the state from here
+        return
+    kept = exposed and last_good.put_back(body)  # type: ignore[union-attr]
+    raise ValueError(f"sphere #{bad}; the world was not stepped" + (" and keeps its last good state" * kept))
 
 
 def _unsteppable(body: np.ndarray) -> str | None:
@@ -209,7 +351,7 @@ def ball(position, radius, mass, velocity, angular_velocity, orientation, restit
         orientation=quaternion("orientation", orientation),
         radius=number("radius", radius, within=RADIUS_RANGE),
         mass=number("mass", mass, within=MASS_RANGE),
-        restitution=number("restitution", restitution, nonnegative=True),
+        restitution=number("restitution", restitution, within=RESTITUTION_RANGE),
         friction=number("friction", friction, nonnegative=True),
         rolling_friction=number("rolling_friction", rolling_friction, nonnegative=True),
         hollow=bool(hollow),
@@ -230,7 +372,7 @@ def balls(positions, radius, mass, velocity, angular_velocity, orientation, rest
         orientation=array_of("orientation", orientation, n, 4),
         radius=array_of("radius", radius, n, None, RADIUS_RANGE),
         mass=array_of("mass", mass, n, None, MASS_RANGE),
-        restitution=array_of("restitution", restitution, n, None, (0.0, math.inf)),
+        restitution=array_of("restitution", restitution, n, None, RESTITUTION_RANGE),
         friction=array_of("friction", friction, n, None, (0.0, math.inf)),
         rolling_friction=array_of("rolling_friction", rolling_friction, n, None, (0.0, math.inf)),
     )
@@ -264,7 +406,7 @@ def plane(position, normal, rotation, size, restitution, friction, rolling_frict
         q = rotations.IDENTITY.copy()
     extent = (math.inf, math.inf) if size is None else plane_size("size", size)
     materials = {
-        "restitution": number("restitution", restitution, nonnegative=True),
+        "restitution": number("restitution", restitution, within=RESTITUTION_RANGE),
         "friction": number("friction", friction, nonnegative=True),
         "rolling_friction": number("rolling_friction", rolling_friction, nonnegative=True),
     }
@@ -278,7 +420,7 @@ def plane(position, normal, rotation, size, restitution, friction, rolling_frict
 # The plane columns a user can write through ``world.planes`` (its columns, or a plane's vectors), what
 # each must hold, and where it lives ("pose": state.planes, moved by a step; "shape": model.planes).
 # Kinds: "bounded" |x| <= limit, "unit" rows of length 1, "extent" positive (inf: unbounded),
-# "material" finite and not negative.
+# "material" finite and not negative, "fraction" from 0 to 1.
 _PLANE_FIELDS = (
     ("center", "pose", "bounded", MAX_COORDINATE),
     ("orientation", "pose", "unit", None),
@@ -288,7 +430,7 @@ _PLANE_FIELDS = (
     ("velocity", "shape", "bounded", MAX_SPEED),
     ("angular_velocity", "shape", "bounded", MAX_SPIN),
     ("half_size", "shape", "extent", None),
-    ("restitution", "shape", "material", None),
+    ("restitution", "shape", "fraction", None),
     ("friction", "shape", "material", None),
     ("rolling_friction", "shape", "material", None),
 )
@@ -297,6 +439,7 @@ _PLANE_RULES = {
     "unit": "must be a unit vector",
     "extent": "must be positive (inf: unbounded)",
     "material": "must be finite and not negative",
+    "fraction": "must be from 0 to 1",
 }
 
 
@@ -309,6 +452,8 @@ def _bad_plane_values(kind: str, arr: np.ndarray, limit: float | None) -> np.nda
         return np.broadcast_to(~(np.abs(length - 1.0) <= UNIT_TOLERANCE), arr.shape)
     if kind == "extent":
         return ~(arr > 0.0)
+    if kind == "fraction":
+        return ~((arr >= 0.0) & (arr <= 1.0))
     return ~((arr >= 0.0) & (arr < math.inf))
 
 
@@ -319,25 +464,63 @@ def plane_columns(shape, pose) -> list[np.ndarray]:
     return [(pose if where == "pose" else shape).full(name)[:n] for name, where, _, _ in _PLANE_FIELDS]
 
 
-def planes_as_stepped(shape, pose) -> np.ndarray:
+class PlanesAsStepped:
+    """Every checked plane column as the last step left it, flattened into one copy, and each plane added
+    since (checked as it was added): what ``reject_bad_planes`` compares with and puts bad values back to.
+
+    Adding a plane appends its row, merged into the copy when a step next looks, so adding P planes costs
+    O(P), not a copy of every plane each time (40,000 planes once took 18 s to load)."""
+
+    def __init__(self, flat: np.ndarray, count: int) -> None:
+        self._flat = flat
+        self._count = count
+        self._added: list[np.ndarray] = []
+        self._widths: tuple[int, ...] = ()  # how many numbers each column has per plane
+
+    def add(self, shape, pose) -> None:
+        """Remember the plane just added (the last of ``shape``'s and ``pose``'s rows)."""
+        i = shape.count - 1
+        row = [c[i].ravel() for c in plane_columns(shape, pose)]
+        self._widths = tuple(len(r) for r in row)
+        self._added.append(np.concatenate(row))
+
+    def flat(self) -> np.ndarray:
+        """The copy, with the planes added since merged in, column by column."""
+        if self._added:
+            added = np.stack(self._added)
+            count = self._count + len(added)
+            parts, at, column = [], 0, 0
+            for width in self._widths:
+                parts.append(self._flat[at : at + self._count * width])
+                parts.append(added[:, column : column + width].ravel())
+                at += self._count * width
+                column += width
+            self._flat, self._count, self._added = np.concatenate(parts), count, []
+        return self._flat
+
+
+def planes_as_stepped(shape, pose) -> PlanesAsStepped:
     """Every checked plane column, flattened into one copy: what ``reject_bad_planes`` compares with."""
-    return np.concatenate([c.ravel() for c in plane_columns(shape, pose)])
+    columns = plane_columns(shape, pose)
+    return PlanesAsStepped(np.concatenate([c.ravel() for c in columns]), shape.count)
 
 
-def reject_bad_planes(shape, pose, good: np.ndarray | None) -> np.ndarray:
+def reject_bad_planes(shape, pose, good: PlanesAsStepped | None) -> PlanesAsStepped:
     """Refuse to step with a NaN, inf or out-of-range value written into a plane (a ``world.planes``
     column or a plane's vector): ValueError naming the plane, the field and the value. ``good`` is
     ``planes_as_stepped`` after the last step: when nothing differs from it there is nothing to check
     (the common case costs one copy and one comparison); every bad entry is put back as it was there,
-    so the world keeps its last good state. Returns the columns checked, flattened."""
+    so the world keeps its last good state. Returns the columns checked."""
     columns = plane_columns(shape, pose)
     now = np.concatenate([c.ravel() for c in columns])
-    if good is not None and good.shape == now.shape and (now == good).all():
-        return now
-    restorable = good is not None and good.shape == now.shape
+    checked = PlanesAsStepped(now, shape.count)
+    good_flat = None if good is None else good.flat()
+    if good_flat is not None and good_flat.shape == now.shape and (now == good_flat).all():
+        return checked
+    restorable = good_flat is not None and good_flat.shape == now.shape
     first, at = None, 0
     for arr, (name, _, kind, limit) in zip(columns, _PLANE_FIELDS, strict=True):
-        before = good[at : at + arr.size].reshape(arr.shape) if restorable else None
+        before = good_flat[at : at + arr.size].reshape(arr.shape) if restorable else None  # type: ignore[index]
         at += arr.size
         bad = _bad_plane_values(kind, arr, limit)
         if not bad.any():
@@ -350,4 +533,4 @@ def reject_bad_planes(shape, pose, good: np.ndarray | None) -> np.ndarray:
             arr[bad] = before[bad]
     if first is not None:
         raise ValueError(f"{first}; the world was not stepped and keeps its last good state")
-    return now
+    return checked

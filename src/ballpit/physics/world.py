@@ -97,7 +97,8 @@ class World:
         self._pairs = PairCache()
         self._warm = WarmStart()
         self._workspace = Workspace()
-        self._good_planes: np.ndarray | None = None  # the plane columns after the last step (validation.py)
+        self._good_planes: validation.PlanesAsStepped | None = None  # the plane columns after the last step
+        self._good_balls = validation.LastGoodBalls()  # the ball states, once views hand them out
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -156,9 +157,7 @@ class World:
 
     @substeps.setter
     def substeps(self, value: int) -> None:
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise ValueError(f"substeps must be a whole number of at least 1, got {value!r}")
-        self.model.substeps = int(value)
+        self.model.substeps = validation.whole_number("substeps", value, 1, validation.MAX_SUBSTEPS)
 
     crowd_limit = _model_number(
         "crowd_limit",
@@ -259,6 +258,7 @@ class World:
         body[:, V] = velocity
         body[:, Q] = orientation
         body[:, W] = angular_velocity
+        self._good_balls.grow(self.state.body)
         return rows.start
 
     def add_plane(
@@ -301,7 +301,10 @@ class World:
         pose.reserve(1)
         pose.full("center")[i] = center
         moving_planes.set_orientation(pose, i, q)
-        self._remember_planes()
+        if self._good_planes is None:
+            self._remember_planes()
+        else:
+            self._good_planes.add(shape, pose)
         return Plane(self, i)
 
     # ------------------------------------------------------------------ edits between steps
@@ -366,10 +369,12 @@ class World:
 
     def _edited(self) -> None:
         """Something a step reads was changed by hand: the kept pairs and warm start are found afresh,
-        and sleeping balls wake."""
+        and sleeping balls wake; the copies a bad value in a ball view is put back from are dropped (a
+        removed ball moves the rows after it)."""
         self._pairs = PairCache()
         self._warm = WarmStart()
         self.state.sleep.wake_all()
+        self._good_balls.forget()
 
     def _remember_planes(self) -> None:
         """Copy the plane columns, to put back a bad value written into them before the next step."""
@@ -389,10 +394,10 @@ class World:
         a crowded step as soft substeps (softstep.py); last, still islands fall asleep. ``profile``
         then holds the step's time per stage.
         """
-        dt = validation.number("dt", dt, positive=True)
+        dt = validation.timestep(dt)
         began = perf_counter()
         model, state = self.model, self.state
-        validation.reject_unsteppable_state(state.body)
+        validation.reject_unsteppable_state(state.body, self._good_balls)
         planes = validation.reject_bad_planes(model.planes, state.planes, self._good_planes)
         before = state.body.copy()
         step = strategies.Step(model, state, self._pairs, self._warm, self._workspace, model.forces(), dt,
@@ -480,7 +485,7 @@ class World:
         """Put the world back as it was at ``snap``; stepping on repeats the original run bit for bit.
 
         The snapshot stays usable: it can be restored again. Live views of balls that did not exist
-        then raise IndexError when read.
+        then raise IndexError, saying so, when used.
         """
         if not isinstance(snap, Snapshot):
             raise TypeError(f"restore takes a Snapshot from World.snapshot(), got {type(snap).__name__}")
@@ -489,6 +494,7 @@ class World:
         )
         self.crowded_steps = snap.crowded_steps
         self._remember_planes()
+        self._good_balls = validation.LastGoodBalls()
 
     def copy(self) -> World:
         """An independent World in the same state (it steps on exactly as this one would)."""

@@ -8,7 +8,7 @@ by ball index.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -21,74 +21,128 @@ from .overlap import first_overlap, first_plane_cut
 _PER_BALL_SHAPE = {"velocity": (3,), "angular_velocity": (3,), "orientation": (4,)}
 
 
+def _sphere_row_layout() -> dict[str, slice]:
+    """Where each value of a [[sphere]] sits in its row of numbers: the position, every ball column,
+    then the colour (NaN: the palette's)."""
+    widths = {"position": 3, **{k: int(np.prod(_PER_BALL_SHAPE.get(k, ()))) for k in schema.BALL_COLUMNS}}
+    widths["color"] = 3
+    layout, at = {}, 0
+    for key, width in widths.items():
+        layout[key] = slice(at, at + width)
+        at += width
+    return layout
+
+
+_SPHERE_ROW = _sphere_row_layout()
+_SPHERE_WIDTH = max(s.stop for s in _SPHERE_ROW.values())
+_DEFAULT_ROW = np.full(_SPHERE_WIDTH, np.nan)  # every ball column's default; position and colour unset
+for _key, _value in schema.BALL_DEFAULTS.items():
+    _DEFAULT_ROW[_SPHERE_ROW[_key]] = np.asarray(_value, dtype=float)
+
+
 @dataclass
-class _Block:
-    """Balls from one entry: where they start in the batch and how to name ball k in messages."""
+class _Grid:
+    """A grid's balls: where they start in the batch, their entry, and how to name ball k in messages."""
 
     start: int
     entry: Entry
-    key: str | None
+    key: str  # where errors about its balls' positions point
     name: Callable[[int], str | None]
+    positions: np.ndarray
+    values: dict[str, np.ndarray]  # one value for the whole grid, or one per ball
+    colors: np.ndarray | None  # None: the palette
 
 
-@dataclass
 class Balls:
     """Balls gathered from [[sphere]] and [[grid]] entries, added to the world in one batch.
 
-    Each entry's properties are kept as given (one value for the whole entry, or one per ball) and
-    expanded to one row per ball only once, in ``column``, so gathering is linear in the entries.
+    Spheres come first, one ball each in file order, so ball k < ``spheres`` is sphere #k+1, and
+    ``sphere_entry(k)`` gives its entry back when an error names it. Each sphere is one row of numbers
+    in a block made for as many as the file has (doubled if more come): a file of half a million
+    spheres keeps 22 numbers a ball, not a Python object for each value. A grid keeps its properties
+    as given (one value for the whole grid, or one per ball), expanded to one row per ball only in
+    ``column``.
     """
 
-    positions: list[np.ndarray] = field(default_factory=list)
-    values: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in schema.BALL_COLUMNS})
-    colors: list[np.ndarray | None] = field(default_factory=list)  # None: the palette
-    blocks: list[_Block] = field(default_factory=list)
-    counts: list[int] = field(default_factory=list)
-    count: int = 0
+    def __init__(self, sphere_entry: Callable[[int], Entry], spheres: int = 16) -> None:
+        self.sphere_entry = sphere_entry
+        self._rows = np.empty((max(spheres, 1), _SPHERE_WIDTH))  # room for as many as the file has
+        self.spheres = 0
+        self.grids: list[_Grid] = []
+        self.count = 0
 
-    def add(
+    def add_sphere(self, position: np.ndarray, props: dict[str, object], color: np.ndarray | None) -> None:
+        """Append one [[sphere]]'s ball (before any grid's): its position, the ball properties it gives
+        (the rest take their defaults) and its colour (None: the palette's)."""
+        if self.grids:
+            raise ValueError("spheres are gathered before grids")
+        if self.spheres == len(self._rows):
+            grown = np.empty((2 * len(self._rows), _SPHERE_WIDTH))
+            grown[: self.spheres] = self._rows
+            self._rows = grown
+        row = self._rows[self.spheres]
+        row[:] = _DEFAULT_ROW
+        row[_SPHERE_ROW["position"]] = position
+        for k, value in props.items():
+            row[_SPHERE_ROW[k]] = value
+        if color is not None:
+            row[_SPHERE_ROW["color"]] = color
+        self.spheres += 1
+        self.count += 1
+
+    def add_grid(
         self,
         e: Entry,
-        key: str | None,
+        key: str,
         positions: np.ndarray,
         props: dict[str, object],
         colors: np.ndarray | None,
         name: Callable[[int], str | None],
     ) -> None:
-        """Append entry ``e``'s balls; ``key`` is where errors about their positions point."""
-        n = len(positions)
-        self.blocks.append(_Block(self.count, e, key, name))
-        self.positions.append(positions)
-        for k in schema.BALL_COLUMNS:
-            self.values[k].append(np.asarray(props[k], dtype=float))
-        self.colors.append(colors)
-        self.counts.append(n)
-        self.count += n
+        """Append a [[grid]]'s balls."""
+        values = {k: np.asarray(props[k], dtype=float) for k in schema.BALL_COLUMNS}
+        self.grids.append(_Grid(self.count, e, key, name, positions, values, colors))
+        self.count += len(positions)
+
+    def _sphere_column(self, k: str) -> np.ndarray:
+        part = self._rows[: self.spheres, _SPHERE_ROW[k]]
+        return part if k in ("position", "color", *_PER_BALL_SHAPE) else part[:, 0]
+
+    def positions(self) -> np.ndarray:
+        """Every ball's position, (N, 3) in batch order."""
+        parts = [self._sphere_column("position"), *(g.positions for g in self.grids)]
+        return np.concatenate(parts) if self.grids else np.array(parts[0])
 
     def column(self, k: str) -> np.ndarray:
-        """Property ``k`` of every ball, one row per ball, in batch order."""
+        """Property ``k`` of every ball, one row per ball, in batch order; the grid's own value when
+        there is one grid and nothing else (``World.add_spheres`` broadcasts it, a million-ball grid
+        needs no million copies)."""
         shape = _PER_BALL_SHAPE.get(k, ())
-        values = self.values[k]
-        if all(v.shape == shape for v in values):  # one value per entry: repeat it for its balls
-            return np.repeat(np.array(values).reshape(-1, *shape), self.counts, axis=0)
-        return np.concatenate(
-            [np.broadcast_to(v, (n, *shape)) for v, n in zip(values, self.counts, strict=True)]
-        )
+        if self.spheres == 0 and len(self.grids) == 1:
+            return self.grids[0].values[k]
+        parts = [self._sphere_column(k)]
+        parts += [np.broadcast_to(g.values[k], (len(g.positions), *shape)) for g in self.grids]
+        return np.concatenate(parts)
 
     def owner(self, k: int) -> tuple[Entry, str | None, str | None]:
         """The entry, key and ball name of ball ``k`` of the batch."""
-        for block in reversed(self.blocks):
-            if k >= block.start:
-                return block.entry, block.key, block.name(k - block.start)
+        if k < self.spheres:
+            return self.sphere_entry(k), "position", None
+        for grid in reversed(self.grids):
+            if k >= grid.start:
+                return grid.entry, grid.key, grid.name(k - grid.start)
         raise IndexError(k)
 
     def sphere_colors(self) -> np.ndarray:
         """(N, 3) colours of the batch: each entry's own, else the palette by ball index."""
-        out = [
-            palette_colors(len(positions), block.start) if colors is None else colors
-            for block, positions, colors in zip(self.blocks, self.positions, self.colors, strict=True)
-        ]
-        return np.concatenate(out) if out else np.zeros((0, 3))
+        colors = np.array(self._sphere_column("color"))
+        unset = np.isnan(colors[:, 0])
+        colors[unset] = palette_colors(self.spheres)[unset]
+        out = [colors]
+        for grid in self.grids:
+            n = len(grid.positions)
+            out.append(palette_colors(n, grid.start) if grid.colors is None else grid.colors)
+        return np.concatenate(out)
 
     def check_overlaps(
         self,

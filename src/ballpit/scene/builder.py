@@ -3,10 +3,15 @@
 Every table is checked before anything is built, so a bad file never gives a half-built world. Balls
 from ``[[sphere]]`` and ``[[grid]]`` tables are gathered in file order (spheres first, then grids) and
 added in one batch; entries are numbered from 1 in file order, per kind.
+
+A file may hold half a million spheres, so each is read and dropped in turn (its parsed table let go
+once its numbers are in the batch), and where a table or key is in the file is looked up only when an
+error names it: loading stays within a few hundred MB for any file under the size cap.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +21,7 @@ from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls
 from .fields import LARGEST, Entry, did_you_mean, show
-from .lines import LineIndex
+from .lines import LineIndex, find_array_item
 from .reading import SceneError, quote_key
 
 
@@ -26,7 +31,15 @@ class Builder:
     def __init__(self, path: Path, text: str, data: dict) -> None:
         self.path = path
         self.data = data
-        self.lines = LineIndex(text)
+        self.text = text
+        self._lines: LineIndex | None = None
+
+    @property
+    def lines(self) -> LineIndex:
+        """Where every table and key is in the file (made on first use: only errors need it)."""
+        if self._lines is None:
+            self._lines = LineIndex(self.text)
+        return self._lines
 
     def build(self) -> Scene:
         """Check every table in file order, then build the World and its appearance."""
@@ -35,9 +48,10 @@ class Builder:
         camera = self.table("camera")
         camera.check_keys(schema.CAMERA_KEYS)
         given = camera.vector("position", None), camera.vector("look_at", None)
-        planes = [self.plane(e) for e in self.array("plane")]
-        balls = Balls()
-        for entry in self.array("sphere"):
+        planes = [self.plane(e) for e in self.array("plane", schema.MAX_PLANES)]
+        spheres = self.data.get("sphere")
+        balls = Balls(lambda k: self.entry("sphere", k, {}), len(spheres) if isinstance(spheres, list) else 0)
+        for entry in self.array("sphere", schema.MAX_BALLS, drop=True):
             self.sphere(entry, balls)
         for entry in self.array("grid"):
             self.grid(entry, balls)
@@ -45,11 +59,13 @@ class Builder:
         world = World(**params)
         plane_colors = self.add_planes(world, planes)
         if balls.count:
-            positions = np.concatenate(balls.positions)
+            positions = balls.positions()
             columns = {k: balls.column(k) for k in schema.BALL_COLUMNS}
-            balls.check_overlaps(positions, columns["radius"], world, self.overlap_tolerance)
+            radii = np.broadcast_to(columns["radius"], (balls.count,))
+            balls.check_overlaps(positions, radii, world, self.overlap_tolerance)
             columns["hollow"] = columns["hollow"].astype(bool)
             world.add_spheres(positions, **columns)
+            del positions, columns, radii
         position, look_at = self.camera(camera, *given, world)
         appearance = Appearance(
             path=self.path,
@@ -77,7 +93,12 @@ class Builder:
                 "restitution_threshold", d["restitution_threshold"], nonnegative=True
             ),
             sleep=e.boolean("sleep", bool(d["sleep"])),
-            substeps=e.integer("substeps", int(d["substeps"]), minimum=1),
+            substeps=e.integer(
+                "substeps",
+                int(d["substeps"]),
+                minimum=schema.SUBSTEPS_RANGE[0],
+                maximum=schema.SUBSTEPS_RANGE[1],
+            ),
         )
         self.overlap_tolerance = e.number("overlap_tolerance", schema.OVERLAP_TOLERANCE, nonnegative=True)
         return params, timestep, e.number("duration", None, positive=True)
@@ -132,10 +153,16 @@ class Builder:
         if not isinstance(value, dict):
             problem = f"'{name}' must be a table written [{name}], got {show(value)}"
             raise SceneError(self.path, problem, line=self.lines.root.key_lines.get(name))
-        return Entry(self.path, f"[{name}]", value, self.lines.table(name))
+        return Entry(self.path, f"[{name}]", value, lambda: self.lines.table(name))
 
-    def array(self, name: str) -> list[Entry]:
-        """The ``[[name]]`` tables, in file order."""
+    def entry(self, name: str, index: int, data: dict) -> Entry:
+        """The ``index``-th (from 0) ``[[name]]`` table as an Entry; where it is in the file is found
+        only if an error asks."""
+        return Entry(self.path, f"{name} #{index + 1}", data, lambda: find_array_item(self.text, name, index))
+
+    def array(self, name: str, most: int | None = None, drop: bool = False) -> Iterator[Entry]:
+        """The ``[[name]]`` tables, in file order, one at a time (refused beyond ``most`` of them). With
+        ``drop``, each parsed table is let go once the next is asked for."""
         value = self.data.get(name, [])
         if not isinstance(value, dict | list):
             problem = f"'{name}' must be tables written [[{name}]], got {show(value)}"
@@ -147,14 +174,22 @@ class Builder:
                 f"each {name} is a table written [[{name}]] (double brackets), not [{name}]",
                 line=where.header_line if where else None,
             )
-        entries = []
+        if most is not None and len(value) > most:
+            raise self.entry(name, most, {}).error(
+                None, f"{len(value):,} of them are more than the {most:,} a scene may have"
+            )
+        return self._entries(name, value, drop)
+
+    def _entries(self, name: str, value: list, drop: bool) -> Iterator[Entry]:
         for i, item in enumerate(value):
-            label = f"{name} #{i + 1}"
             if not isinstance(item, dict):
                 line = self.lines.root.key_lines.get(name)
-                raise SceneError(self.path, f"must be a table, got {show(item)}", line=line, entry=label)
-            entries.append(Entry(self.path, label, item, self.lines.array_item(name, i)))
-        return entries
+                raise SceneError(
+                    self.path, f"must be a table, got {show(item)}", line=line, entry=f"{name} #{i + 1}"
+                )
+            yield self.entry(name, i, item)
+            if drop:
+                value[i] = None
 
     # ------------------------------------------------------------------ entries
     def plane(self, e: Entry) -> tuple[Entry, dict, np.ndarray | None]:
@@ -173,7 +208,7 @@ class Builder:
             rotation=rotation,
             normal=normal,
             size=None if size is None else (float(size[0]), float(size[1])),
-            restitution=e.number("restitution", d["restitution"], nonnegative=True),
+            restitution=e.number("restitution", d["restitution"], within=schema.RESTITUTION_RANGE),
             friction=e.number("friction", d["friction"], nonnegative=True),
             rolling_friction=e.number("rolling_friction", d["rolling_friction"], nonnegative=True),
             velocity=e.vector("velocity", d["velocity"]),
@@ -181,36 +216,22 @@ class Builder:
         )
         return e, kwargs, e.color("color")
 
-    def ball_properties(self, e: Entry) -> dict[str, object]:
-        """The add_sphere arguments (but position) shared by a [[sphere]] or by a [[grid]]'s balls."""
-        d = schema.BALL_DEFAULTS
-        orientation = e.nonzero_vector("orientation", 4)
-        return dict(
-            radius=e.number("radius", d["radius"], positive=True),
-            mass=e.number("mass", d["mass"], positive=True),
-            velocity=e.vector("velocity", d["velocity"]),
-            angular_velocity=e.vector("angular_velocity", d["angular_velocity"]),
-            orientation=(
-                np.array(d["orientation"], dtype=float)
-                if orientation is None
-                else orientation / exact.norm(orientation)
-            ),
-            restitution=e.number("restitution", d["restitution"], nonnegative=True),
-            friction=e.number("friction", d["friction"], nonnegative=True),
-            rolling_friction=e.number("rolling_friction", d["rolling_friction"], nonnegative=True),
-            hollow=float(e.boolean("hollow", bool(d["hollow"]))),
-        )
+    def ball_properties(self, e: Entry, given_only: bool = False) -> dict[str, object]:
+        """The add_sphere arguments (but position) shared by a [[sphere]] or by a [[grid]]'s balls; with
+        ``given_only``, only those the entry gives."""
+        props = {}
+        for key in schema.BALL_COLUMNS:
+            if key in e.data:
+                props[key] = _ball_property(e, key)
+            elif not given_only:
+                props[key] = _BALL_DEFAULTS[key]
+        return props
 
     def sphere(self, e: Entry, balls: Balls) -> None:
         e.check_keys(schema.SPHERE_KEYS)
-        if balls.count >= schema.MAX_BALLS:
-            raise e.error(None, f"one ball more than the {schema.MAX_BALLS:,} a scene may have")
         e.require("position")
         position = e.vector("position", None)
-        props = self.ball_properties(e)
-        color = e.color("color")
-        colors = None if color is None else color[None, :]
-        balls.add(e, "position", position[None, :], props, colors, lambda k: None)
+        balls.add_sphere(position, self.ball_properties(e, given_only=True), e.color("color"))
 
     def grid(self, e: Entry, balls: Balls) -> None:
         e.check_keys(schema.GRID_KEYS)
@@ -269,7 +290,7 @@ class Builder:
             positions, props["velocity"], jitter, velocity_jitter, seed
         )
         key = "center" if center is not None else "corner"
-        balls.add(e, key, positions, props, self.grid_colors(e, n), lambda k: layout.ball_name(count, k))
+        balls.add_grid(e, key, positions, props, self.grid_colors(e, n), lambda k: layout.ball_name(count, k))
 
     def grid_colors(self, e: Entry, n: int) -> np.ndarray | None:
         """(n, 3) colours a [[grid]] gives (one, or a list cycled), or None for the palette."""
@@ -280,3 +301,30 @@ class Builder:
             cycle = np.array([e.parse_color("color", v, value) for v in value])
             return cycle[np.arange(n) % len(cycle)]
         return np.broadcast_to(e.parse_color("color", value), (n, 3)).copy()
+
+
+def _ball_property(e: Entry, key: str) -> object:
+    """Ball property ``key``, which entry ``e`` gives, checked."""
+    if key in ("radius", "mass"):
+        return e.number(key, None, positive=True)
+    if key in ("velocity", "angular_velocity"):
+        return e.vector(key, None)
+    if key == "orientation":
+        q = e.nonzero_vector(key, 4)
+        return q / exact.norm(q)
+    if key == "restitution":
+        return e.number(key, None, within=schema.RESTITUTION_RANGE)
+    if key == "hollow":
+        return float(e.boolean(key, False))
+    return e.number(key, None, nonnegative=True)  # friction, rolling friction
+
+
+def _default(value: object) -> object:
+    if isinstance(value, bool):
+        return float(value)
+    if isinstance(value, tuple):
+        return frozen(value)
+    return value
+
+
+_BALL_DEFAULTS = {key: _default(value) for key, value in schema.BALL_DEFAULTS.items()}

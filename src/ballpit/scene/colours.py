@@ -1,8 +1,8 @@
 """The one palette and restitution colour ramp, for scene files and the viewer alike.
 
 Balls a scene does not colour take the palette by ball index. Planes show their bounciness: unbounded
-planes are a neutral floor; finite ones go slate blue at restitution 0, green at 0.5, orange at 1 and
-above (the viewer's legend uses the same stops). Colours are sRGB components 0..1.
+planes are a neutral floor; finite ones go slate blue at restitution 0, green at 0.5, orange at 1 (the
+viewer's legend uses the same stops). Colours are sRGB components 0..1.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ def palette_colors(count: int, first: int = 0) -> np.ndarray:
 
 
 def restitution_colors(restitutions: object) -> np.ndarray:
-    """(P, 3) plane colours showing bounciness: slate blue at 0, green at 0.5, orange at 1 and above."""
+    """(P, 3) plane colours showing bounciness: slate blue at 0, green at 0.5, orange at 1."""
     e = np.clip(np.asarray(restitutions, dtype=float).reshape(-1), 0.0, 1.0)
     return np.stack([np.interp(e, RESTITUTION_STOPS, RESTITUTION_COLORS[:, k]) for k in range(3)], axis=-1)
 

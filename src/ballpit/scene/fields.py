@@ -9,7 +9,7 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -86,22 +86,32 @@ class Entry:
     """One table of the file under validation: typed getters that raise ``SceneError`` with context.
 
     A getter returns its ``default`` when the key is absent; ``data`` is the parsed table, ``where``
-    the table's place in the file (None when the line index could not find it).
+    the table's place in the file (None when the line index could not find it), or how to find it:
+    looked for only when an error names a line.
     """
 
-    def __init__(self, path: Path, label: str, data: dict, where: Table | None) -> None:
+    def __init__(
+        self, path: Path, label: str, data: dict, where: Table | Callable[[], Table | None] | None
+    ) -> None:
         self.path = path
         self.label = label
         self.data = data
-        self.where = where
+        self._where = where
+
+    @property
+    def where(self) -> Table | None:
+        if callable(self._where):
+            self._where = self._where()
+        return self._where
 
     def line(self, key: str | None = None) -> int | None:
         """The line of ``key``, else of the table's header, else None."""
-        if self.where is None:
+        where = self.where
+        if where is None:
             return None
-        if key is not None and key in self.where.key_lines:
-            return self.where.key_lines[key]
-        return self.where.header_line
+        if key is not None and key in where.key_lines:
+            return where.key_lines[key]
+        return where.header_line
 
     def error(self, key: str | None, problem: str, value: object = ...) -> SceneError:
         """A ``SceneError`` about ``key`` of this entry, quoting ``value`` when one is given."""
@@ -125,29 +135,44 @@ class Entry:
             raise self.error(None, f"missing required key '{key}'")
 
     def number(
-        self, key: str, default: float | None, *, positive: bool = False, nonnegative: bool = False
+        self,
+        key: str,
+        default: float | None,
+        *,
+        positive: bool = False,
+        nonnegative: bool = False,
+        within: tuple[float, float] | None = None,
     ) -> float | None:
-        """A number within ±1e9 (optionally > 0, then at least 1e-9, or ≥ 0) as a float."""
+        """A number within ±1e9 (optionally > 0, then at least 1e-9, ≥ 0, or ``within`` a range) as a
+        float."""
         if key not in self.data:
             return default
         value = self.data[key]
         if not is_number(value):
             raise self.error(key, "must be a number", value)
-        x = float(value)
+        bound = "between 1e-9 and 1e9" if positive else f"between {'0' if nonnegative else '-1e9'} and 1e9"
+        (x,) = self._floats(key, [value], value, f"must be {bound}")
         if not math.isfinite(x):
             raise self.error(key, "must be finite", value)
         if positive and x <= 0:
             raise self.error(key, "must be positive", value)
         if nonnegative and x < 0:
             raise self.error(key, "must not be negative", value)
-        if positive and not SMALLEST <= x <= LARGEST:
-            raise self.error(key, "must be between 1e-9 and 1e9", value)
-        if abs(x) > LARGEST:
-            raise self.error(key, f"must be between {'0' if nonnegative else '-1e9'} and 1e9", value)
+        if within is not None and not within[0] <= x <= within[1]:
+            raise self.error(key, f"must be between {within[0]:g} and {within[1]:g}", value)
+        if (positive and not SMALLEST <= x) or abs(x) > LARGEST:
+            raise self.error(key, f"must be {bound}", value)
         return x
 
-    def integer(self, key: str, default: int, *, minimum: int = 0) -> int:
-        """A whole number (``true`` is not one) of at least ``minimum``."""
+    def _floats(self, key: str, items: list, whole: object, bound: str) -> list[float]:
+        """``items`` (numbers) as floats; an integer too large for a float is refused as beyond ``bound``."""
+        try:
+            return [float(v) for v in items]
+        except OverflowError:
+            raise self.error(key, bound, whole) from None
+
+    def integer(self, key: str, default: int, *, minimum: int = 0, maximum: int | None = None) -> int:
+        """A whole number (``true`` is not one) of at least ``minimum`` (and at most ``maximum``)."""
         if key not in self.data:
             return default
         value = self.data[key]
@@ -155,6 +180,8 @@ class Entry:
             raise self.error(key, "must be a whole number", value)
         if value < minimum:
             raise self.error(key, f"must be at least {minimum}", value)
+        if maximum is not None and value > maximum:
+            raise self.error(key, f"must be at most {maximum:,}", value)
         return value
 
     def boolean(self, key: str, default: bool) -> bool:
@@ -175,12 +202,13 @@ class Entry:
             raise self.error(key, f"must be a list of {length} numbers", value)
         if len(value) != length:
             raise self.error(key, f"must have {length} components, not {len(value)}", value)
-        arr = np.array(value, dtype=float)
-        if not np.isfinite(arr).all():
+        bound = "components must be between -1e9 and 1e9"
+        floats = self._floats(key, value, value, bound)  # checked in Python: a scene may have a million
+        if not all(math.isfinite(x) for x in floats):
             raise self.error(key, "must be finite", value)
-        if (np.abs(arr) > LARGEST).any():
-            raise self.error(key, "components must be between -1e9 and 1e9", value)
-        return arr
+        if not all(-LARGEST <= x <= LARGEST for x in floats):
+            raise self.error(key, bound, value)
+        return np.array(floats)
 
     def nonzero_vector(self, key: str, length: int = 3) -> np.ndarray | None:
         """A vector that must not be zero (a direction); None when absent."""
@@ -198,7 +226,7 @@ class Entry:
         shape = "a number" if count == 1 else f"a number or a list of {count} numbers"
         if not all(is_number(v) for v in items) or (isinstance(value, list) and len(value) != count):
             raise self.error(key, f"must be {shape}", value)
-        arr = np.array(items, dtype=float)
+        arr = np.array(self._floats(key, items, value, "must be between 1e-9 and 1e9"))
         if not np.isfinite(arr).all():
             raise self.error(key, "must be finite", value)
         if (arr <= 0).any():
@@ -233,7 +261,7 @@ class Entry:
                 raise self.error(key, _COLOR_SHAPE, whole)
             return hex_to_rgb(value)
         if isinstance(value, list) and len(value) == 3 and all(is_number(v) for v in value):
-            rgb = np.array(value, dtype=float)
+            rgb = np.array(self._floats(key, value, whole, "components must be between 0 and 1"))
             if not np.isfinite(rgb).all() or (rgb < 0).any() or (rgb > 1).any():
                 raise self.error(key, "components must be between 0 and 1", whole)
             return rgb

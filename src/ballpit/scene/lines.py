@@ -8,6 +8,7 @@ scan is linear in the length of a line, whatever the line holds.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 
@@ -71,12 +72,26 @@ def _parts(name: str) -> list[str]:
     return [p[1:-1] if len(p) >= 2 and p[0] == p[-1] and p[0] in "\"'" else p for p in parts]
 
 
-class LineIndex:
-    """Header and key line numbers, found by scanning the raw TOML text.
+def _events(text: str) -> Iterator[tuple[int, str, list[str]]]:
+    """The table headers and keys of ``text`` in order: (line, what it is ("[" or "[[" for a header,
+    "key"), the name's parts). Lines inside multi-line strings and multi-line arrays are skipped, so a
+    value that happens to look like ``[x]`` or ``key =`` is not mistaken for a header or a key."""
+    depth = 0  # open brackets/braces of a value continuing onto later lines
+    multiline: str | None = None  # the closing delimiter of an open multi-line string
+    for number, line in enumerate(text.splitlines(), start=1):
+        if multiline is None and depth == 0:
+            header = _header(line)
+            if header:
+                yield number, header[0], _parts(header[1])
+                continue
+            key = _KEY.match(line)
+            if key:
+                yield number, "key", _parts(key.group(1))
+        depth, multiline = _scan_line(line, depth, multiline)
 
-    Lines inside multi-line strings and multi-line arrays are skipped, so a value that happens to look
-    like ``[x]`` or ``key =`` is not mistaken for a header or a key.
-    """
+
+class LineIndex:
+    """Header and key line numbers, found by scanning the raw TOML text (see ``_events``)."""
 
     def __init__(self, text: str) -> None:
         self.root = Table(None, {})
@@ -84,25 +99,17 @@ class LineIndex:
         self.arrays: dict[str, list[Table]] = {}
         self.first_header: dict[str, int] = {}  # by a header's first name part: where it first appears
         current = self.root
-        depth = 0  # open brackets/braces of a value continuing onto later lines
-        multiline: str | None = None  # the closing delimiter of an open multi-line string
-        for number, line in enumerate(text.splitlines(), start=1):
-            if multiline is None and depth == 0:
-                header = _header(line)
-                if header:
-                    parts = _parts(header[1])
-                    name = ".".join(parts)
-                    self.first_header.setdefault(parts[0], number)
-                    current = Table(number, {})
-                    if header[0] == "[[":
-                        self.arrays.setdefault(name, []).append(current)
-                    else:
-                        self.tables.setdefault(name, current)
-                    continue
-                key = _KEY.match(line)
-                if key:
-                    current.key_lines.setdefault(".".join(_parts(key.group(1))), number)
-            depth, multiline = _scan_line(line, depth, multiline)
+        for number, kind, parts in _events(text):
+            if kind == "key":
+                current.key_lines.setdefault(".".join(parts), number)
+                continue
+            name = ".".join(parts)
+            self.first_header.setdefault(parts[0], number)
+            current = Table(number, {})
+            if kind == "[[":
+                self.arrays.setdefault(name, []).append(current)
+            else:
+                self.tables.setdefault(name, current)
 
     def table(self, name: str) -> Table | None:
         """Where ``[name]`` is, if the file has it."""
@@ -112,6 +119,25 @@ class LineIndex:
         """Where the ``index``-th (from 0) ``[[name]]`` is, if the file has it."""
         items = self.arrays.get(name, [])
         return items[index] if index < len(items) else None
+
+
+def find_array_item(text: str, name: str, index: int) -> Table | None:
+    """Where the ``index``-th (from 0) ``[[name]]`` of ``text`` is, found by one scan that keeps only
+    that table: what an error about one of half a million spheres needs, without indexing them all."""
+    seen = -1
+    found: Table | None = None
+    for number, kind, parts in _events(text):
+        if kind == "key":
+            if found is not None:
+                found.key_lines.setdefault(".".join(parts), number)
+            continue
+        if found is not None:
+            break
+        if kind == "[[" and ".".join(parts) == name:
+            seen += 1
+            if seen == index:
+                found = Table(number, {})
+    return found
 
 
 def _scan_line(line: str, depth: int, multiline: str | None) -> tuple[int, str | None]:

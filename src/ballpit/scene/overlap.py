@@ -14,6 +14,9 @@ from ..physics.broadphase import sphere_pairs
 
 CROWD = 64  # balls in one broad-phase cell beyond which the cell is checked on its own first
 CROWD_SAMPLE = 256  # how many of a crowd's balls (the first, by index) that check compares
+# Balls per slab: more are checked a slab at a time, so the broad phase's pair lists (about 700 bytes a
+# ball) stay some 25 MB, not 700 MB for a million-ball grid.
+SLAB = 1 << 15
 
 
 def first_overlap(positions: np.ndarray, radii: np.ndarray, tolerance: float = 0.0) -> tuple[int, int] | None:
@@ -22,9 +25,30 @@ def first_overlap(positions: np.ndarray, radii: np.ndarray, tolerance: float = 0
     First means the smallest later ball j, then the smallest partner i, so an error names the ball
     that a file added last. Where more than ``CROWD`` balls crowd one cell, the pair reported is the
     first among the crowd's first ``CROWD_SAMPLE`` balls, when they overlap at all.
+
+    More than ``SLAB`` balls are cut into slabs of about that many along the axis they spread most on;
+    a slab checks its balls with those of the others that reach into it, so every pair that overlaps
+    is seen in a slab where both ends are (where their boxes meet along the axis).
     """
     positions = np.asarray(positions, dtype=float)
     radii = np.asarray(radii, dtype=float)
+    if len(positions) <= SLAB:
+        return _first_overlap(positions, radii, tolerance)
+    axis = int(np.argmax(positions.max(axis=0) - positions.min(axis=0)))
+    x = positions[:, axis]
+    reach = radii + max(tolerance, 0.0)
+    starts = np.unique(np.sort(x)[::SLAB])
+    found: list[tuple[int, int]] = []
+    for k, start in enumerate(starts):
+        end = starts[k + 1] if k + 1 < len(starts) else np.inf
+        members = np.flatnonzero((x + reach >= start) & (x - reach < end))
+        pair = _first_overlap(positions[members], radii[members], tolerance)
+        if pair is not None:
+            found.append((int(members[pair[0]]), int(members[pair[1]])))
+    return min(found, key=lambda p: (p[1], p[0])) if found else None
+
+
+def _first_overlap(positions: np.ndarray, radii: np.ndarray, tolerance: float) -> tuple[int, int] | None:
     if len(positions) < 2:
         return None
     pair = _crowd_overlap(positions, radii, tolerance)

@@ -7,11 +7,12 @@ the file is ``lines.LineIndex``'s job.
 
 from __future__ import annotations
 
+import codecs
 import re
 import tomllib
 from pathlib import Path
 
-from ..inputs import InputRefused, open_regular, read_capped
+from ..cli.inputs import InputRefused, open_regular, read_capped
 
 SHOWN = 60  # characters: a value or key longer than this is shortened in messages, ending in …
 _NAMED = {"\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}
@@ -95,7 +96,8 @@ MAX_BYTES = 16 * 1024 * 1024  # a scene file larger than this is refused unread
 
 
 def read_text(path: Path) -> str:
-    """The file as UTF-8 text; ``SceneError`` naming the reason when it cannot be read.
+    """The file as UTF-8 text (without a byte-order mark); ``SceneError`` naming the reason when it
+    cannot be read.
 
     Only regular files up to ``MAX_BYTES`` are read, opened so that a read cannot wait (inputs.py), so
     a pipe, a device, a kernel file like /proc/kmsg or a huge file can neither block nor fill the memory.
@@ -107,11 +109,16 @@ def read_text(path: Path) -> str:
         raise SceneError(path, str(e)) from None
     except OSError as e:
         raise SceneError(path, f"cannot read: {e.strerror or e}") from None
+    if raw.startswith(_UTF16_MARKS):
+        raise SceneError(path, "starts with a UTF-16 byte-order mark: save it as UTF-8 text", line=1)
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")  # a UTF-8 byte-order mark (Windows Notepad writes one) is skipped
     except UnicodeDecodeError as e:
         line = raw[: e.start].count(b"\n") + 1
         raise SceneError(path, "not UTF-8 text; is this a scene file?", line=line) from None
+
+
+_UTF16_MARKS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)  # UTF-32's begin with these too
 
 
 _AT_LINE = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 
-from ..physics import DEFAULT_TIMESTEP, INTEGRATOR_NAMES, World
+from ..physics import DEFAULT_TIMESTEP, INTEGRATOR_NAMES, World, validation
 
 
 def _defaults(function: Callable, names: tuple[str, ...]) -> dict[str, object]:
@@ -65,6 +65,12 @@ GRID_JITTER = 0.0  # m, the largest random offset of each ball along each axis
 GRID_VELOCITY_JITTER = 0.0  # m/s, the same for each ball's velocity
 GRID_SEED = 0
 MAX_BALLS = 1_000_000  # in the whole scene, spheres and grids together
+# Planes are a scene's walls and slopes. The broad phase tests every ball's box against each plane in
+# turn (broadphase.sphere_plane_pairs), some 20 µs a plane, so 100,000 planes cost seconds a step, far
+# past any use; a file of more is a mistake or an attack (a 16 MiB file can hold 1.6 million).
+MAX_PLANES = 100_000
+SUBSTEPS_RANGE = (1, validation.MAX_SUBSTEPS)  # [world] substeps, as World.substeps takes them
+RESTITUTION_RANGE = validation.RESTITUTION_RANGE  # a ball's or a plane's, as World takes them
 
 # Balls or a ball and a plane may touch at the start (a cradle, a ball resting on the floor), but not
 # interpenetrate by more than this, unless [world] overlap_tolerance says otherwise: a scene saved from

@@ -516,7 +516,8 @@ def run(
     With ``record``, the timeline it showed is written there when the window closes (or on Ctrl+C).
 
     With no display it prints one line saying how to render offscreen instead and returns 1. With a
-    ``trajectory`` (``replay.read_trajectory``) the window plays it instead of running the physics.
+    ``trajectory`` (``ballpit.cli.trajectory.read_trajectory``) the window plays it instead of running
+    the physics.
     """
     problem = backend.display_problem()
     if problem is not None:

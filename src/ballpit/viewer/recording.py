@@ -17,7 +17,7 @@ from __future__ import annotations
 import threading
 from pathlib import Path
 
-from ballpit.writers import TrajectoryWriter
+from ballpit.cli.trajectory import TrajectoryWriter
 
 from .simulation import Simulation
 

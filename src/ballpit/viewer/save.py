@@ -28,6 +28,7 @@ import tomlkit
 from tomlkit.items import AoT, Table
 
 from ..scene.overlap import deepest_overlap
+from ..scene.reading import read_text
 from ..scene.schema import OVERLAP_TOLERANCE
 from .camera import Camera
 from .simulation import Simulation
@@ -205,7 +206,7 @@ def scene_document(
     """
     world, initial, look = sim.world, sim.initial, sim.appearance
     path = sim.path
-    text = path.read_text(encoding="utf-8") if path is not None and path.is_file() else ""
+    text = read_text(path) if path is not None and path.is_file() else ""
     doc = tomlkit.parse(_without_header(text))
 
     sc = Scales.of(world, camera)

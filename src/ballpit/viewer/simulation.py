@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cli.trajectory import Trajectory
 from ..physics.profile import RunProfile
 from ..scene import Appearance, Scene, read_scene, scene_of
 from ..scene.colours import palette_colors
-from .replay import Trajectory
 from .timeline import Timeline
 
 MAX_FRAME_SECONDS = 0.25

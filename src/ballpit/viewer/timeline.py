@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from ..cli.trajectory import Trajectory
 from .energyplot import EnergyTrace
 from .ghosts import CATCH_UP_STEPS, Ghosts, total_energy
 from .history import History
-from .replay import Replay, Trajectory
+from .replay import Replay
 
 JUMP_SECONDS = 1.0  # Shift+← / Shift+→
 

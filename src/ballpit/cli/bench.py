@@ -1,7 +1,7 @@
 """Step-rate benchmarks: free flight, a falling grid of balls piling into a box, a pile at rest, and
 the slopes and see-saw demos.
 
-Every measurement runs in its own process (``python -m ballpit.bench --one ...``) so engines and sizes
+Every measurement runs in its own process (``python -m ballpit.cli.bench --one ...``) so engines and sizes
 do not share caches or memory, and so the peak resident memory per ball can be read honestly.
 PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile for comparison.
 
@@ -103,7 +103,7 @@ def _ballpit_world(workload: str, n: int):
     import ballpit
 
     if workload in DEMOS:  # the bundled demo as it is (its own ball count; ``n`` is not used)
-        from .scene import read_scene, resolve_scene_path
+        from ..scene import read_scene, resolve_scene_path
 
         return read_scene(resolve_scene_path(workload)).world
     world = ballpit.World(integrator="rk4")
@@ -193,7 +193,7 @@ def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float)
     The child runs with ``-P``: the current directory is not put on its path, so a folder named
     ``ballpit`` there (a clone, seen from the folder above it) cannot shadow the installed package.
     """
-    cmd = [sys.executable, "-P", "-m", "ballpit.bench", "--one", engine, workload, str(n), str(steps)]
+    cmd = [sys.executable, "-P", "-m", "ballpit.cli.bench", "--one", engine, workload, str(n), str(steps)]
     label = f"{engine} {workload} N={n}"
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)

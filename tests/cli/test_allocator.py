@@ -12,7 +12,7 @@ GLIBC = sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc"
 # Allocate and touch a 20 MB array, free it, and print how much of it the process still holds (MB).
 PROBE = """
 import sys
-from ballpit.allocator import keep_freed_memory
+from ballpit.cli.allocator import keep_freed_memory
 if sys.argv[1] == "keep":
     assert keep_freed_memory()
 def resident():
@@ -38,9 +38,10 @@ def test_freed_arrays_stay_in_the_process_only_when_asked():
 
 def test_the_command_line_asks_for_it(monkeypatch):
     from ballpit import cli
+    from ballpit.cli import commands
 
     asked = []
-    monkeypatch.setattr(cli, "keep_freed_memory", lambda: asked.append(True) or True)
+    monkeypatch.setattr(commands, "keep_freed_memory", lambda: asked.append(True) or True)
     with pytest.raises(SystemExit):
         cli.main(["--help"])
     assert asked

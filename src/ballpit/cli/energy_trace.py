@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .physics import World
+from ..physics import World
 
 
 @dataclass(frozen=True, eq=False)

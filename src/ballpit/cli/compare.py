@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..physics import World
+from ..physics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
 from .energy_trace import EnergyRecorder, EnergyTrace
-from .physics import World
-from .physics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
 from .simulate import progress_bar, step_longer_than_run, step_plan
 
 INTEGRATORS = INTEGRATOR_NAMES
@@ -50,7 +50,7 @@ def open_scene(scene: str | Path) -> SceneInput:
 
     Raises ``SceneError`` (one line) for a bad or missing file.
     """
-    from .scene import read_scene, resolve_scene_path
+    from ..scene import read_scene, resolve_scene_path
 
     info = read_scene(resolve_scene_path(scene))
     return SceneInput(world=info.world, timestep=info.timestep, duration=info.duration, name=info.name)

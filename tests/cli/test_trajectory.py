@@ -1,12 +1,11 @@
-"""``view --replay`` against recordings that gained balls and against hostile files (issue #25,
-section 3): a record made after B added a ball replays; a FIFO, a device, a deflate bomb, a header
-claiming 10¹² rows or ids that are not 0..N-1 are one-line errors with exit status 2, before any
-window and before anything large is read."""
+"""The trajectory format read against hostile files: a FIFO, a device, a deflate bomb, a header
+claiming 10¹² rows, a column of another length or of other than real numbers, orientations that are
+not unit quaternions, ids that are not 0..N-1 are one-line errors with exit status 2 from ``view
+--replay``, before any window and before anything large is read."""
 
 from __future__ import annotations
 
 import io
-import math
 import os
 import subprocess
 import sys
@@ -17,54 +16,11 @@ import numpy as np
 import pytest
 
 from ballpit import cli
-from ballpit.scene import read_scene
-from ballpit.viewer import replay as replay_module
-from ballpit.viewer.recording import Recorder
-from ballpit.viewer.replay import Replay, read_trajectory
-from ballpit.viewer.simulation import Simulation
-from ballpit.writers import TRAJECTORY_COLUMNS
+from ballpit.cli import trajectory as trajectory_module
+from ballpit.cli.trajectory import TRAJECTORY_COLUMNS, read_trajectory
 
 ROOT = Path(__file__).resolve().parents[2]
 SLOPES = ROOT / "scenes" / "slopes.toml"
-
-
-def _record_with_a_shot(path: Path) -> tuple[Simulation, int]:
-    """slopes.toml recorded in the viewer's way: 20 steps, a ball shot in (what B does), 20 more."""
-    sim = Simulation(read_scene(SLOPES), SLOPES, step_budget=math.inf)
-    recorder = Recorder(path, sim)
-    sim.start()
-    dt = sim.timestep
-    sim.advance(20 * dt + 1e-9)
-    shot = sim.add_ball((1.0, 0.0, 0.0), position=(0.0, 6.0, 2.0), radius=0.2, velocity=(0.0, 0.0, -3.0))
-    sim.advance(20 * dt + 1e-9)
-    recorder.finish()
-    return sim, shot
-
-
-@pytest.mark.parametrize("suffix", [".npz", ".csv"])
-def test_a_record_made_after_a_ball_was_shot_in_replays(tmp_path, suffix):
-    path = tmp_path / f"run{suffix}"
-    live, shot = _record_with_a_shot(path)
-    t = read_trajectory(path, n_balls=5)
-    assert t.frames == 41 and t.balls == 6
-    assert t.balls_at(0) == 5 and t.balls_at(20) == 5 and t.balls_at(21) == 6 and t.balls_at(40) == 6
-    assert np.isnan(t.position[20, 5]).all()  # not there yet
-    rtol = 0 if suffix == ".npz" else 1e-8
-    np.testing.assert_allclose(t.position[40], live.world.spheres.positions, rtol=rtol, atol=1e-12)
-
-    sim = Simulation(read_scene(SLOPES), SLOPES, trajectory=t)
-    assert sim.error is None and sim.ball_count == 5
-    assert len(sim.appearance.sphere_colors) == 6  # a colour for the added ball, as B gives it
-    sim.start()
-    sim.advance(30 * sim.timestep)  # plays on past the frame the ball appears in
-    assert sim.ball_count == 6 and len(sim.prev_positions) == 6
-    current = sim.timeline.replay.current
-    np.testing.assert_allclose(sim.world.spheres.positions, t.position[current], rtol=rtol, atol=1e-12)
-    assert sim.world.spheres[shot].radius == pytest.approx(np.median(read_scene(SLOPES).world.spheres.radii))
-    sim.toggle_pause()
-    sim.scrub(0.0)  # back before the shot: the scene's five balls again
-    assert sim.ball_count == 5 and len(sim.trails.ordered()[0]) == 5
-    np.testing.assert_array_equal(sim.world.spheres.positions, t.position[0, :5])
 
 
 def _write_csv(path: Path, rows: list[list[float]]) -> Path:
@@ -148,7 +104,7 @@ def test_a_header_claiming_a_trillion_rows_is_refused_before_allocating(tmp_path
 def test_a_deflate_bomb_is_refused_before_it_is_inflated(tmp_path, capsys, monkeypatch):
     """Arrays whose inflated size is beyond the limit (here lowered to 1 MiB, so the bomb stays small to
     build; the real limit is 2 GiB) are refused from the archive's directory, unread."""
-    monkeypatch.setattr(replay_module, "MAX_BYTES", 1 << 20)
+    monkeypatch.setattr(trajectory_module, "MAX_BYTES", 1 << 20)
     path = tmp_path / "bomb.npz"
     rows = (2 << 20) // 8
     with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
@@ -157,7 +113,7 @@ def test_a_deflate_bomb_is_refused_before_it_is_inflated(tmp_path, capsys, monke
     assert path.stat().st_size < 200_000  # a small file that inflates to 30 MiB
     err = _replay_status(path, capsys)
     assert "more than a trajectory may have (1 MiB)" in err
-    assert replay_module.MAX_BYTES == 1 << 20 and 2 << 30 == 2147483648
+    assert trajectory_module.MAX_BYTES == 1 << 20 and 2 << 30 == 2147483648
 
 
 def test_a_bomb_that_understates_its_size_is_refused_unread(tmp_path, capsys):
@@ -199,28 +155,119 @@ def test_a_kernel_file_whose_reads_block_is_refused_by_every_command():
         assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
 
 
-def test_replay_seek_outside_the_added_balls_keeps_the_scene_balls(tmp_path):
-    path = tmp_path / "run.csv"
-    _record_with_a_shot(path)
-    world = read_scene(SLOPES).world
-    t = read_trajectory(path)
-    r = Replay(world, t)
-    for frame in (40, 3, 25, 0):
-        r.seek(frame)
-        assert len(world.spheres) == t.balls_at(frame)
-        np.testing.assert_array_equal(world.spheres.positions, t.position[frame, : t.balls_at(frame)])
-
-
 def test_csv_rows_that_never_end_stop_at_the_size_limit(monkeypatch):
     """A CSV that keeps growing while it is read (a run still writing it) is read no further than the
     limit: here an endless stream of rows against a limit of 1 MiB."""
     import itertools
 
-    monkeypatch.setattr(replay_module, "MAX_BYTES", 1 << 20)
+    monkeypatch.setattr(trajectory_module, "MAX_BYTES", 1 << 20)
     row = ",".join(["0"] * len(TRAJECTORY_COLUMNS)) + "\n"
-    lines = replay_module._capped_lines(itertools.repeat(row), 1 << 20)
+    lines = trajectory_module._capped_lines(itertools.repeat(row), 1 << 20)
     read = 0
-    with pytest.raises(replay_module.InputRefused, match=r"more than a trajectory may have \(1 MiB\)"):
+    with pytest.raises(trajectory_module.InputRefused, match=r"more than a trajectory may have \(1 MiB\)"):
         for line in lines:
             read += len(line)
     assert read <= 1 << 20
+
+
+def _trajectory_npz(path: Path, rows: int = 10, **columns: tuple[tuple, str, bytes]) -> Path:
+    """An .npz of the trajectory columns: ``rows`` zeros each (qw ones), except those given as
+    (shape, dtype descr, payload)."""
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            default = (
+                np.ones(rows) if column == "qw" else np.arange(rows) % 2 if column == "id" else np.zeros(rows)
+            )
+            shape, descr, payload = columns.get(column, ((rows,), "<f8", default.astype("<f8").tobytes()))
+            header = io.BytesIO()
+            np.lib.format.write_array_header_1_0(
+                header, {"descr": descr, "fortran_order": False, "shape": shape}
+            )
+            archive.writestr(f"{column}.npy", header.getvalue() + payload)
+    return path
+
+
+def test_a_column_of_the_wrong_length_is_refused_from_its_header_before_it_is_inflated(tmp_path, capsys):
+    # Its data is corrupt past the header (a wrong checksum): reading it whole would fail differently.
+    rows = 1 << 17
+    path = _trajectory_npz(tmp_path / "long.npz", x=((rows,), "<f8", bytes(rows * 8)))
+    blob = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as archive:
+        crc = archive.getinfo("x.npy").CRC.to_bytes(4, "little")
+    path.write_bytes(bytes(blob).replace(crc, bytes(4 * [0x5A])))
+    err = _replay_status(path, capsys)
+    assert "the trajectory columns have different lengths: 'x' has 131,072 rows, 'time' 10" in err
+
+
+@pytest.mark.slow
+def test_a_1_mb_replay_whose_column_inflates_to_1_gib_is_refused_within_100_mb(tmp_path):
+    # It was inflated first and then refused, at a peak of 1.08 GB.
+    path = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for column in TRAJECTORY_COLUMNS:
+            rows = (1 << 30) // 8 if column == "x" else 10
+            header = io.BytesIO()
+            np.lib.format.write_array_header_1_0(
+                header, {"descr": "<f8", "fortran_order": False, "shape": (rows,)}
+            )
+            with archive.open(f"{column}.npy", "w", force_zip64=True) as member:
+                member.write(header.getvalue())
+                for _ in range(rows * 8 // (1 << 20)) if column == "x" else ():
+                    member.write(bytes(1 << 20))
+                member.write(bytes(rows * 8) if column != "x" else b"")
+    assert path.stat().st_size < 2e6
+    code = (
+        "import sys\n"
+        "from ballpit import cli\n"
+        "status = cli.main(['view', 'slopes', '--replay', sys.argv[1]])\n"
+        "peak = next(line for line in open('/proc/self/status') if line.startswith('VmHWM'))\n"
+        "print(status, peak.split()[1])  # this process's own peak (ru_maxrss may carry the parent's)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=300)
+    status, peak_kib = map(int, r.stdout.split())
+    assert status == 2 and "'x' has 134,217,728 rows, 'time' 10" in r.stderr, r.stderr
+    assert peak_kib * 1024 < 100e6, f"{peak_kib / 1024:.0f} MiB"
+
+
+@pytest.mark.parametrize(
+    ("column", "dtype", "fragment"),
+    [
+        ("x", "<c16", "column 'x' holds complex numbers (complex128), not real numbers"),
+        ("y", "<U3", "column 'y' holds text (<U3), not real numbers"),
+        ("time", "|b1", "column 'time' holds true/false values (bool), not real numbers"),
+    ],
+)
+def test_a_column_that_does_not_hold_real_numbers_is_refused(tmp_path, capsys, column, dtype, fragment):
+    values = np.zeros(10, dtype=dtype) if dtype != "<U3" else np.array(["1"] * 10, dtype=dtype)
+    path = _trajectory_npz(tmp_path / "typed.npz", **{column: ((10,), dtype, values.tobytes())})
+    assert fragment in _replay_status(path, capsys)
+
+
+@pytest.mark.parametrize(
+    ("q", "fragment"),
+    [
+        ((0.0, 0.0, 0.0, 0.0), "orientation (0, 0, 0, 0) is not a unit quaternion (its length is 0"),
+        (
+            (0.0, 0.0, 0.0, 1.001),
+            "orientation (0, 0, 0, 1.001) is not a unit quaternion (its length is 1.001, not 1 within 1e-05)",
+        ),
+    ],
+)
+def test_an_orientation_that_is_not_a_unit_quaternion_is_refused(tmp_path, capsys, q, fragment):
+    rows = [_row(0.0, 0), _row(0.0, 1)]
+    rows[1][-4:] = q
+    path = _write_csv(tmp_path / "turned.csv", rows)
+    assert f"record 1, ball 1: {fragment}" in _replay_status(path, capsys)
+
+
+def test_an_npz_of_int_and_float32_columns_still_plays(tmp_path):
+    rows = 10
+    floats = {c: ((rows,), "<f4", np.zeros(rows, "<f4").tobytes()) for c in ("x", "y", "vx")}
+    path = _trajectory_npz(
+        tmp_path / "narrow.npz",
+        rows,
+        id=((rows,), "<i8", (np.arange(rows) % 5).astype("<i8").tobytes()),
+        **floats,
+    )
+    t = read_trajectory(path, n_balls=5)
+    assert (t.frames, t.balls) == (2, 5)

@@ -18,7 +18,7 @@ import sys
 import traceback
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 class _Stream(io.TextIOWrapper):
@@ -38,6 +38,7 @@ class _Stream(io.TextIOWrapper):
 def run_in_process(*args: str | Path, cwd: Path = ROOT, **_: object) -> subprocess.CompletedProcess:
     """``ballpit ARGS`` in this process (extra keywords such as ``timeout`` are accepted and ignored)."""
     from ballpit import cli
+    from ballpit.cli import commands
 
     argv = [str(a) for a in args]
     out, err = _Stream(), _Stream()
@@ -45,7 +46,7 @@ def run_in_process(*args: str | Path, cwd: Path = ROOT, **_: object) -> subproce
     os.chdir(cwd)
     # the process-wide malloc setting the command line asks for is tested in a process of its own
     # (test_allocator.py); here it would stay with the test process
-    keep, cli.keep_freed_memory = cli.keep_freed_memory, lambda: True
+    keep, commands.keep_freed_memory = commands.keep_freed_memory, lambda: True
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
@@ -58,7 +59,7 @@ def run_in_process(*args: str | Path, cwd: Path = ROOT, **_: object) -> subproce
                 traceback.print_exc()
                 status = 1
     finally:
-        cli.keep_freed_memory = keep
+        commands.keep_freed_memory = keep
         os.chdir(here)
     return subprocess.CompletedProcess(["ballpit", *argv], int(status or 0), out.text(), err.text())
 

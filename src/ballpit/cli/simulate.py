@@ -14,9 +14,11 @@ from dataclasses import dataclass, fields
 import numpy as np
 from tqdm import tqdm
 
-from .physics import DEFAULT_TIMESTEP, Contacts, World
-from .physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
-from .writers import EventWriter, TrajectoryWriter
+from ..physics import DEFAULT_TIMESTEP, Contacts, World
+from ..physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
+from ..physics.validation import MAX_TIMESTEP
+from .trajectory import TrajectoryWriter
+from .writers import EventWriter
 
 
 @dataclass(frozen=True)
@@ -160,7 +162,9 @@ def step_plan(duration: float, dt: float) -> list[tuple[int, float]]:
 
 def step_longer_than_run(duration: float, dt: float) -> str | None:
     """What is wrong when a step of ``dt`` is longer than the whole run (the command line refuses it:
-    the run would be one step of ``duration`` instead), else None."""
+    the run would be one step of ``duration`` instead) or than any step may be, else None."""
+    if dt > MAX_TIMESTEP:
+        return f"a step of {dt:g} s is longer than a step may be ({MAX_TIMESTEP:g} s): use a smaller --dt"
     if dt <= duration * (1 + 1e-9):
         return None
     return (

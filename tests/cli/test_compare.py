@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ballpit.compare import compare, format_table, open_scene
+from ballpit.cli.compare import compare, format_table, open_scene
 
 from .bouncing_box import (
     DT,
@@ -25,9 +25,9 @@ from .bouncing_box import (
     euler_gain_per_step_law,
     write_scene,
 )
-from .cli_runner import run_in_process
+from .runner import run_in_process
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FLIGHTS = 3
 DURATION = 3.03  # s: a whole number of steps, just past 3 flights of the exact motion (3.029 s)
 STEPS = round(DURATION / DT)

@@ -1,4 +1,5 @@
-"""The ``ballpit`` command line: view, check, simulate, render, bench, scenes.
+"""The ``ballpit`` commands: view, check, simulate, compare, render, bench, scenes (``cli.main`` runs
+them, its stop handlers already in place).
 
 Bad input of any kind (a bad scene, a missing file, a bad option) exits with status 2 and one line
 on stderr naming the file and the problem, never a traceback. Heavy modules (the viewer, the
@@ -9,64 +10,24 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from . import __version__
+from .. import __version__
+from . import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from .allocator import keep_freed_memory
 from .arguments import OneLineParser, one_line
 from .arguments import count as _count
 from .arguments import positive as _positive
 from .arguments import size as _size
 
-# Nothing heavy above this line (``ballpit`` imports NumPy only on first use): ``main`` installs its
-# Ctrl+C and SIGTERM handlers before the physics, the scene reader or the viewer are imported.
-
 if TYPE_CHECKING:
-    from .physics import World
+    from ..physics import World
 
 COMMANDS = ("view", "check", "simulate", "compare", "render", "bench", "scenes")
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
-EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a tool cut off by `| head`
-
-
-class Terminated(BaseException):
-    """SIGTERM or SIGHUP, raised in the main thread so that every cleanup runs (like KeyboardInterrupt)."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-
-_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
-
-
-def _on_stop_signal(signum: int, frame: object) -> None:
-    """The first stop signal unwinds the run; any later one is ignored, so the cleanup finishes."""
-    for name in _STOP_SIGNALS:
-        if hasattr(signal, name):
-            signal.signal(getattr(signal, name), signal.SIG_IGN)
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
-    raise Terminated(signum)
-
-
-def _install_stop_handlers() -> dict[int, object]:
-    """Route SIGINT, SIGTERM and SIGHUP to _on_stop_signal; returns the handlers they had."""
-    previous: dict[int, object] = {}
-    for name in _STOP_SIGNALS:
-        signum = getattr(signal, name, None)
-        if signum is None or signal.getsignal(signum) == signal.SIG_IGN:  # e.g. nohup: keep ignoring
-            continue
-        try:
-            previous[signum] = signal.signal(signum, _on_stop_signal)
-        except ValueError:  # not the main thread: leave signals alone
-            break
-    return previous
 
 
 class UsageError(ValueError):
@@ -85,7 +46,7 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    from .physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
+    from ..physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
 
     labels = [integrator.label for integrator in INTEGRATORS.values()]
     integrator_labels = ", ".join(labels[:-1]) + " and " + labels[-1]  # "Euler, RK2, RK4 and ..."
@@ -178,42 +139,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit status.
-
-    The stop handlers come first, so Ctrl+C or SIGTERM while the modules still import exits 130 or
-    143 with one line, never a traceback. A closed stdout (``| head``) ends the run quietly.
-    """
-    previous = _install_stop_handlers()
-    try:
-        status = _run(argv)
-        sys.stdout.flush()  # here, not at exit, so a closed pipe is caught below
-        return status
-    except KeyboardInterrupt:
-        print("ballpit: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Terminated as e:
-        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
-    except BrokenPipeError:
-        _silence_stdout()
-        return EXIT_BROKEN_PIPE
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-
-
-def _silence_stdout() -> None:
-    """Point stdout at /dev/null, so the interpreter's last flush of what is left finds no closed pipe."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError, AttributeError):  # stdout replaced by something without a descriptor
-        pass
-
-
-def _run(argv: Sequence[str] | None) -> int:
+def run(argv: Sequence[str] | None) -> int:
+    """Parse ``argv`` (``sys.argv[1:]`` when None) and run its command; returns the exit status."""
     keep_freed_memory()
     args_list = list(sys.argv[1:] if argv is None else argv)
     if args_list and args_list[0] == "bench":
@@ -222,7 +149,7 @@ def _run(argv: Sequence[str] | None) -> int:
         args_list = ["view", *args_list]
     parser = build_parser()
     args = parser.parse_args(args_list)
-    from .scene import SceneError
+    from ..scene import SceneError
     from .writers import OutputError, OutputFailed
 
     try:
@@ -240,7 +167,7 @@ def _looks_like_scene(arg: str) -> bool:
 
 
 def _load(scene_arg: str):
-    from .scene import read_scene, resolve_scene_path
+    from ..scene import read_scene, resolve_scene_path
 
     return read_scene(resolve_scene_path(scene_arg))
 
@@ -261,7 +188,7 @@ class StepTotals:
     on to another observer (the energy plot) if there is one."""
 
     def __init__(self, then: Callable[[World], None] | None) -> None:
-        from .physics.profile import RunProfile
+        from ..physics.profile import RunProfile
 
         self.totals = RunProfile()
         self.then = then
@@ -277,7 +204,8 @@ class StepTotals:
 
 def _simulate(args: argparse.Namespace) -> int:
     from .simulate import MAX_STEPS, format_summary, run, step_count, step_longer_than_run
-    from .writers import EventWriter, OutputError, TrajectoryWriter
+    from .trajectory import TrajectoryWriter
+    from .writers import EventWriter, OutputError
 
     info = _load(args.scene)
     world = info.world
@@ -360,7 +288,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _view(args: argparse.Namespace) -> int:
-    from .scene import resolve_scene_path
+    from ..scene import resolve_scene_path
     from .writers import check_output_path
 
     if args.record is not None:
@@ -369,7 +297,7 @@ def _view(args: argparse.Namespace) -> int:
         raise UsageError("--record and --replay cannot be used together")
     path = world = None
     if args.scene is not None:
-        from .scene.loading import unknown_scene
+        from ..scene.loading import unknown_scene
 
         unknown = unknown_scene(args.scene)
         if unknown is not None:
@@ -379,7 +307,7 @@ def _view(args: argparse.Namespace) -> int:
         world = _load(str(path)).world  # a bad scene gets its one-line error before a window opens
     trajectory = None
     if args.replay is not None:
-        from .viewer.replay import TrajectoryError, read_trajectory
+        from .trajectory import TrajectoryError, read_trajectory
 
         world = world if world is not None else _load("slopes").world
         try:
@@ -388,7 +316,7 @@ def _view(args: argparse.Namespace) -> int:
             print(f"ballpit: {e}", file=sys.stderr)
             return EXIT_BAD_INPUT
     try:
-        from .viewer.app import run
+        from ..viewer.app import run
     except ImportError as e:
         print(
             f"ballpit: the viewer is not available ({e}); 'ballpit simulate' runs scenes headless",
@@ -399,8 +327,8 @@ def _view(args: argparse.Namespace) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from .scene import resolve_scene_path
-    from .writers import OutputError, OutputFailed, check_name_lengths
+    from ..scene import resolve_scene_path
+    from .writers import OutputError, OutputFailed, check_name_lengths, check_output_place
 
     path = resolve_scene_path(args.scene)
     duration = args.duration or _load(str(path)).duration or 10.0
@@ -411,9 +339,9 @@ def _render(args: argparse.Namespace) -> int:
         raise OutputError(
             f"{args.out}: --out must be a .gif, a .png or a folder for frames, not {out.suffix!r}"
         )
-    _check_render_path(out, args.out, folder)
+    check_output_place(out, "--out", folder)
     try:
-        from .viewer.render import frame_count, render
+        from ..viewer.render import frame_count, render
     except ImportError as e:
         print(f"ballpit: offscreen rendering is not available ({e})", file=sys.stderr)
         return EXIT_FAILED
@@ -422,7 +350,7 @@ def _render(args: argparse.Namespace) -> int:
         frame_count(duration, args.fps, args.size, kind)
     except ValueError as e:
         raise UsageError(f"render --duration {duration:g}: {e}") from None
-    created = _missing_folders(out if folder else out.parent)
+    created = [out] if folder and not out.exists() else []  # a folder for frames is made; nothing above it
     before = _render_files(out, folder)
     try:
         _check_writable(out if folder else out.parent, args.out)
@@ -437,34 +365,16 @@ def _render(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _check_render_path(out: Path, raw: str, folder: bool) -> None:
-    """OutputError unless ``out`` can be made: every existing part of its path up to it a folder."""
-    from .writers import OutputError
-
-    try:
-        for parent in (out, *out.parents) if folder else out.parents:
-            if parent.exists():
-                if not parent.is_dir():
-                    raise OutputError(f"{raw}: --out: {str(parent)!r} is a file, not a folder")
-                break
-    except OSError as e:
-        raise OutputError(f"{raw}: --out: {e.strerror or e}") from None
-
-
 def _check_writable(folder: Path, raw: str) -> None:
-    """OutputError, before any frame is drawn, unless ``folder`` can be made and a file written in it."""
+    """OutputError, before any frame is drawn, unless ``folder`` can be made (its parent is there) and a
+    file written in it."""
     from .writers import OutputError
 
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(exist_ok=True)
         tempfile.TemporaryFile(dir=folder).close()
     except OSError as e:
         raise OutputError(f"{raw}: --out: cannot write in {str(folder)!r}: {e.strerror or e}") from None
-
-
-def _missing_folders(folder: Path) -> list[Path]:
-    """The folders on the way to ``folder`` that do not exist yet, deepest first."""
-    return [p for p in (folder, *folder.parents) if not p.exists()]
 
 
 def _render_files(out: Path, folder: bool) -> dict[Path, tuple[int, int]]:
@@ -483,14 +393,14 @@ def _render_files(out: Path, folder: bool) -> dict[Path, tuple[int, int]]:
 def _remove_render_output(
     out: Path, folder: bool, before: dict[Path, tuple[int, int]], created: list[Path]
 ) -> None:
-    """Remove what a stopped render wrote (files new or changed since ``before``) and the folders it made."""
+    """Remove what a stopped render wrote (files new or changed since ``before``) and the folder it made."""
     for file, stamp in _render_files(out, folder).items():
         if before.get(file) != stamp:
             try:
                 file.unlink()
             except OSError:
                 pass
-    for made in created:  # deepest first; only if empty
+    for made in created:  # only if empty
         try:
             made.rmdir()
         except OSError:
@@ -507,7 +417,7 @@ def _bench(argv: list[str]) -> int:
 
 
 def _scenes(args: argparse.Namespace) -> int:
-    from .scene import bundled_scenes
+    from ..scene import bundled_scenes
 
     for path in bundled_scenes():
         first = next(
@@ -515,7 +425,3 @@ def _scenes(args: argparse.Namespace) -> int:
         )
         print(f"{path.stem:<12} {first}")
     return EXIT_OK
-
-
-if __name__ == "__main__":
-    sys.exit(main())

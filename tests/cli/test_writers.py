@@ -11,14 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit import cli, writers
+from ballpit import cli
+from ballpit.cli import trajectory as trajectory_module
+from ballpit.cli import writers
+from ballpit.cli.simulate import step_plan
 from ballpit.physics import Contacts
 from ballpit.scene import read_scene
-from ballpit.simulate import step_plan
 
-from .cli_runner import run_in_process
+from .runner import run_in_process
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SLOPES = ROOT / "scenes" / "slopes.toml"
 TRAJECTORY = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw".split(",")
 EVENTS = "time,kind,a,b,x,y,z,nx,ny,nz,impulse".split(",")
@@ -145,7 +147,8 @@ def test_csv_and_npz_hold_exactly_the_run(tmp_path, slopes_reference):
 @pytest.mark.slow
 def test_many_small_chunks_give_the_same_files(tmp_path, monkeypatch, slopes_reference):
     """Chunks of 7 rows: trajectory records and step contacts are split across many chunks."""
-    monkeypatch.setattr(writers, "_CHUNK_ROWS", 7)
+    monkeypatch.setattr(writers, "CHUNK_ROWS", 7)
+    monkeypatch.setattr(trajectory_module, "CHUNK_ROWS", 7)
     trajectory, events, _ = slopes_reference
     for suffix in ("csv", "npz"):
         out, ev = tmp_path / f"t.{suffix}", tmp_path / f"e.{suffix}"

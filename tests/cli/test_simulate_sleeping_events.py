@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.simulate import run
-from ballpit.writers import EventWriter
+from ballpit.cli.simulate import run
+from ballpit.cli.writers import EventWriter
 
 DT = 1 / 240
 

@@ -1,6 +1,6 @@
 """The command line: exit codes, one-line errors, output files and their columns.
 
-Run in this process (``cli_runner.py``) except where the process itself is under test: signals, file
+Run in this process (``runner.py``) except where the process itself is under test: signals, file
 size limits and the console script start a real ``python -m ballpit``.
 """
 
@@ -20,8 +20,8 @@ import pytest
 
 from ballpit.scene import load_scene
 
-from .cli_runner import ROOT
-from .cli_runner import run_in_process as ballpit
+from .runner import ROOT
+from .runner import run_in_process as ballpit
 
 TRAJECTORY_HEADER = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw"
 EVENTS_HEADER = "time,kind,a,b,x,y,z,nx,ny,nz,impulse"
@@ -103,7 +103,7 @@ BAD_SCENES = [
     (
         "negative restitution",
         "[[plane]]\nsize = 4\nrestitution = -0.5\n",
-        [":3:", "plane #1", "key 'restitution'", "must not be negative", "-0.5"],
+        [":3:", "plane #1", "key 'restitution'", "must be between 0 and 1", "-0.5"],
     ),
     ("negative friction", BALL + "friction = -0.1\n", [":3:", "sphere #1", "key 'friction'", "-0.1"]),
     ("negative drag", "[world]\nlinear_drag = -1\n", [":2:", "[world]", "key 'linear_drag'"]),
@@ -452,7 +452,7 @@ def test_a_background_run_is_killed_when_its_test_fails_or_times_out():
 def test_a_background_run_dies_with_a_test_process_that_is_killed_outright(tmp_path):
     """As when a time limit kills pytest itself: no ``finally`` runs, and still nothing is left."""
     code = (
-        "import sys, time; sys.path.insert(0, sys.argv[1]); from tests.test_cli import start; "
+        "import sys, time; sys.path.insert(0, sys.argv[1]); from tests.cli.test_commands import start; "
         "p = start('simulate', 'scenes/pile10k.toml', '--duration', '60', '-q'); "
         "print(p.pid, flush=True); time.sleep(600)"
     )
@@ -543,7 +543,7 @@ def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
     keep = tmp_path / "frames" / "notes.txt"  # not ours: stays
     keep.parent.mkdir()
     keep.write_text("mine\n")
-    for folder in (tmp_path / "frames", tmp_path / "new" / "frames"):
+    for folder in (tmp_path / "frames", tmp_path / "new"):
         args = ["render", "scenes/slopes.toml", "--out", f"{folder}/", "--duration", "5", "--size", "64x48"]
         with running(*args) as proc:
             wait_for(lambda f=folder: f.is_dir() and len(list(f.glob("frame_*.png"))) >= 5)
@@ -555,6 +555,30 @@ def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
         "frames",
         "frames/notes.txt",
     ]
+
+
+def test_render_makes_no_missing_folder_on_the_way_to_its_output_as_simulate_makes_none(tmp_path):
+    # A mistyped --out once made a folder at the root of the file system.
+    for out in ("missing/demo.gif", "missing/frame.png", "missing/frames/", "missing/deeper/frames/"):
+        r = ballpit("render", "scenes/slopes.toml", "--out", tmp_path / out, "--duration", "0.1")
+        assert_user_error(r, "--out: directory", "missing", "does not exist")
+        same = ballpit("simulate", "scenes/slopes.toml", "--out", tmp_path / "missing" / "t.csv")
+        assert_user_error(same, "--out: directory", "missing", "does not exist")
+    assert list(tmp_path.iterdir()) == []
+    r = ballpit(
+        "render",
+        "scenes/slopes.toml",
+        "--out",
+        f"{tmp_path / 'frames'}/",
+        "--duration",
+        "0.1",
+        "--fps",
+        "10",
+        "--size",
+        "32x32",
+    )
+    assert r.returncode == 0, r.stderr  # the folder for the frames itself is the output, and is made
+    assert len(list((tmp_path / "frames").glob("frame_*.png"))) == 1
 
 
 def test_render_into_a_path_through_a_file_is_one_line(tmp_path):

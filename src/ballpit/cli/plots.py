@@ -12,8 +12,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..physics.integrators import INTEGRATORS
 from .energy_trace import EnergyRecorder, EnergyTrace
-from .physics.integrators import INTEGRATORS
 from .writers import AtomicFile, OutputError
 
 if TYPE_CHECKING:

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit import bench
+from ballpit.cli import bench
 
 
 @pytest.mark.parametrize("n", [1, 30, 1000])

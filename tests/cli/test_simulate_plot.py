@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ballpit.energy_trace import EnergyRecorder
+from ballpit.cli.energy_trace import EnergyRecorder
+from ballpit.cli.simulate import run
 from ballpit.scene import load_scene
-from ballpit.simulate import run
 
 from .bouncing_box import DT, E0, MASS, V0, Y0, G, euler_gain_per_step_law, write_scene
-from .cli_runner import run_in_process
-from .test_cli import interrupt_while_writing
+from .runner import run_in_process
+from .test_commands import interrupt_while_writing
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def ballpit(*args: str | Path) -> subprocess.CompletedProcess:

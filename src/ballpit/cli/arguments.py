@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 from typing import NoReturn
 
 EXIT_BAD_INPUT = 2
@@ -18,6 +19,13 @@ class OneLineParser(argparse.ArgumentParser):
     Subcommand parsers made by ``add_subparsers`` are of the same class. Control characters in the
     message (an option value holding a newline or a terminal escape) are shown escaped.
     """
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        # A value that starts like a negative number ("-5x10", "-1e-3") is a value, so its own check
+        # names what is wrong with it; argparse took only "-5" or "-.5" for a number, and "--size -5x10"
+        # said "expected one argument". No option of ours is a dash and a digit.
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str) -> NoReturn:  # type: ignore[override]
         text = one_line(message, limit=500)

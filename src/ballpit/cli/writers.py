@@ -1,5 +1,6 @@
-"""Trajectory and contact-event writers (CSV or NPZ), complete or not at all.
+"""Outputs written complete or not at all, and the contact-event writer (CSV or NPZ).
 
+The trajectory's writer is in ``trajectory.py``, beside its reader; both writers are built on these.
 Each writer fills a temporary file beside its target (``run.npz.<pid>.partial``) and renames it into
 place only when the run finishes, so a crash, a Ctrl+C or a bad option never leaves a truncated file
 that looks complete. A process killed outright (SIGKILL, a power cut) cannot remove its temporary file;
@@ -22,14 +23,13 @@ from typing import IO
 
 import numpy as np
 
-from .physics import Contacts
-from .physics.contacts import KIND_NAMES
+from ..physics import Contacts
+from ..physics.contacts import KIND_NAMES
 
-TRAJECTORY_COLUMNS = ("time", "id", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz", "qx", "qy", "qz", "qw")
 EVENT_COLUMNS = ("time", "kind", "a", "b", "x", "y", "z", "nx", "ny", "nz", "impulse")
 FORMATS = (".csv", ".npz")
-_FLOAT = "%.9g"
-_CHUNK_ROWS = 100_000  # rows formatted per write
+FLOAT_FORMAT = "%.9g"
+CHUNK_ROWS = 100_000  # rows formatted per write
 
 
 class OutputError(ValueError):
@@ -41,7 +41,7 @@ class OutputFailed(Exception):
 
 
 @contextmanager
-def _writing(path: Path) -> Iterator[None]:
+def writing(path: Path) -> Iterator[None]:
     """Turn an OSError while writing ``path`` into OutputFailed naming the file and the reason."""
     try:
         yield
@@ -74,16 +74,31 @@ def check_output_path(path: Path, what: str) -> str:
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"{path}: {what} must end in .csv or .npz, not {suffix or 'no suffix'!r}")
+    check_output_place(path, what)
+    return suffix
+
+
+def check_output_place(path: Path, what: str, folder: bool = False) -> None:
+    """OutputError unless ``path`` (a file, or with ``folder`` a folder of frames) can be made where it
+    is: names that fit, not a folder where a file goes, and the folder it goes into already there.
+    Every command that writes checks its outputs here, so none makes folders on the way (a mistyped
+    path once made one at the root of the file system)."""
     check_name_lengths(path, what)
     try:
-        if path.is_dir():
+        if path.is_dir() and not folder:
             raise OutputError(f"{path}: {what} is a directory")
-        parent = path.parent if str(path.parent) else Path(".")
+        if path.exists() and not path.is_dir() and folder:
+            raise OutputError(f"{path}: {what}: {str(path)!r} is a file, not a folder")
+        parent = directory_of(path)
+        for above in (parent, *parent.parents):  # the nearest part that exists must be a folder
+            if above.exists():
+                if not above.is_dir():
+                    raise OutputError(f"{path}: {what}: {str(above)!r} is a file, not a folder")
+                break
         if not parent.is_dir():
             raise OutputError(f"{path}: {what}: directory {str(parent)!r} does not exist")
     except OSError as e:
         raise OutputError(f"{shorten(path)}: {what}: {e.strerror or e}") from None
-    return suffix
 
 
 def temp_path(target: Path, pid: int | None = None) -> Path:
@@ -112,7 +127,7 @@ def remove_stale_temps(target: Path) -> list[Path]:
     process is gone); returns them. Older runs hid theirs (a leading dot): those go too."""
     removed = []
     try:
-        entries = list(os.scandir(_directory(target)))
+        entries = list(os.scandir(directory_of(target)))
     except OSError:
         return removed
     for entry in entries:
@@ -225,11 +240,10 @@ class ColumnSpool:
         self.file.close()
 
 
-def _directory(path: Path) -> Path:
+def directory_of(path: Path) -> Path:
     return path.parent if str(path.parent) else Path(".")
 
 
-_TRAJECTORY_TYPES = {"id": (np.dtype(np.int64), None)}
 _EVENT_TYPES = {
     "kind": (
         np.dtype(f"<U{max(map(len, KIND_NAMES))}"),
@@ -240,7 +254,7 @@ _EVENT_TYPES = {
 }
 
 
-class _SpooledOutput:
+class SpooledOutput:
     """Commit or discard for a writer whose rows go to ``out`` (CSV text) or ``spool`` (.npz columns,
     typed by ``types`` when the archive is written)."""
 
@@ -254,7 +268,7 @@ class _SpooledOutput:
 
     def commit(self) -> None:
         self._flush()
-        with _writing(self.path):
+        with writing(self.path):
             if self.spool is not None:
                 self.spool.write_npz(self.out.file, self.types)
                 self.spool.close()
@@ -268,91 +282,7 @@ class _SpooledOutput:
             self.out.discard()
 
 
-class TrajectoryWriter(_SpooledOutput):
-    """Every ball's state at the recorded times: one row per ball per record.
-
-    ``record`` copies the state into a preallocated buffer; full buffers go to disk as CSV text, or
-    to the ``.npz``'s column spool. The number of balls may change between records (the viewer adds
-    balls): ball ``i`` is always id ``i``, and new balls get the next ids.
-    """
-
-    types = _TRAJECTORY_TYPES
-
-    def __init__(
-        self, path: Path, n_balls: int, option: str = "--out", records_per_chunk: int | None = None
-    ) -> None:
-        self.path = path
-        self.format = check_output_path(path, option)
-        self.chunk_records = records_per_chunk  # 1: every record is its own chunk, so it can be cut off
-        self._marks: list[int] = []  # where each chunk begins: a byte offset (.csv) or spool chunk (.npz)
-        self.spool = ColumnSpool(TRAJECTORY_COLUMNS, _directory(path)) if self.format == ".npz" else None
-        self.out = AtomicFile(
-            path, "w" if self.format == ".csv" else "wb"
-        )  # after the spool: its error leaves nothing
-        self._allocate(n_balls)
-        self.records = 0
-        self.row_format = ",".join(["%.9g", "%d"] + [_FLOAT] * (len(TRAJECTORY_COLUMNS) - 2)) + "\n"
-        if self.format == ".csv":
-            self.out.file.write(",".join(TRAJECTORY_COLUMNS) + "\n")
-
-    def _allocate(self, n_balls: int) -> None:
-        self.n = n_balls
-        self.records_per_chunk = self.chunk_records or max(1, _CHUNK_ROWS // max(1, n_balls))
-        self.buffer = np.empty((self.records_per_chunk, n_balls, len(TRAJECTORY_COLUMNS)))
-        self.buffer[:, :, 1] = np.arange(n_balls)
-        self.filled = 0
-
-    def record(self, time: float, position, velocity, angular_velocity, orientation) -> None:
-        if len(position) != self.n:  # balls were added: rows of the new count from here on
-            self._flush()
-            self._allocate(len(position))
-        row = self.buffer[self.filled]
-        row[:, 0] = time
-        row[:, 2:5] = position
-        row[:, 5:8] = velocity
-        row[:, 8:11] = angular_velocity
-        row[:, 11:15] = orientation
-        self.filled += 1
-        self.records += 1
-        if self.filled == self.records_per_chunk:
-            self._flush()
-
-    def _flush(self) -> None:
-        if self.filled == 0:
-            return
-        rows = self.buffer[: self.filled].reshape(-1, len(TRAJECTORY_COLUMNS))
-        with _writing(self.path):
-            if self.spool is None:
-                self._marks.append(self.out.file.tell())
-                self.out.file.write((self.row_format * len(rows)) % tuple(rows.ravel().tolist()))
-            else:
-                self._marks.append(len(self.spool.chunks))
-                self.spool.add(rows)
-        self.filled = 0
-
-    def truncate(self, records: int) -> None:
-        """Keep only the first ``records`` records (the viewer resuming from the past drops its future).
-        Records already written can be cut off only when each is its own chunk (``records_per_chunk=1``)."""
-        if records >= self.records:
-            return
-        written = self.records - self.filled
-        if records >= written:  # still in the buffer
-            self.filled = records - written
-        else:
-            if self.chunk_records != 1:
-                raise ValueError("records already written can be cut off only with records_per_chunk=1")
-            self._flush()
-            mark = self._marks[records]
-            del self._marks[records:]
-            if self.spool is None:
-                self.out.file.truncate(mark)
-                self.out.file.seek(mark)
-            else:
-                self.spool.truncate(mark)
-        self.records = records
-
-
-class EventWriter(_SpooledOutput):
+class EventWriter(SpooledOutput):
     """Every contact the solver resolved: time, kind, the two bodies, point, normal and impulse."""
 
     types = _EVENT_TYPES
@@ -360,12 +290,12 @@ class EventWriter(_SpooledOutput):
     def __init__(self, path: Path) -> None:
         self.path = path
         self.format = check_output_path(path, "--events")
-        self.spool = ColumnSpool(EVENT_COLUMNS, _directory(path)) if self.format == ".npz" else None
+        self.spool = ColumnSpool(EVENT_COLUMNS, directory_of(path)) if self.format == ".npz" else None
         self.out = AtomicFile(path, "w" if self.format == ".csv" else "wb")
         self.pending: list[Contacts] = []
         self.pending_rows = 0
         self.count = 0
-        self.row_format = ",".join(["%.9g", "%s", "%d", "%d"] + [_FLOAT] * 7) + "\n"
+        self.row_format = ",".join(["%.9g", "%s", "%d", "%d"] + [FLOAT_FORMAT] * 7) + "\n"
         if self.format == ".csv":
             self.out.file.write(",".join(EVENT_COLUMNS) + "\n")
 
@@ -375,7 +305,7 @@ class EventWriter(_SpooledOutput):
         self.pending.append(contacts)
         self.pending_rows += len(contacts)
         self.count += len(contacts)
-        if self.pending_rows >= _CHUNK_ROWS:
+        if self.pending_rows >= CHUNK_ROWS:
             self._flush()
 
     def _flush(self) -> None:
@@ -383,7 +313,7 @@ class EventWriter(_SpooledOutput):
             return
         c = Contacts.concatenate(self.pending)
         self.pending, self.pending_rows = [], 0
-        with _writing(self.path):
+        with writing(self.path):
             self._write(c)
 
     def _write(self, c: Contacts) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import ballpit
-from ballpit.simulate import (
+from ballpit.cli.simulate import (
     MAX_STEPS,
     Energy,
     RunSummary,
@@ -20,9 +20,9 @@ from ballpit.simulate import (
     step_plan,
 )
 
-from .cli_runner import run_in_process
+from .runner import run_in_process
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_step_plan_ends_exactly_and_refuses_more_than_max_steps():

@@ -1,0 +1,1 @@
+"""Tests of the command line and the headless tools (src/ballpit/cli/)."""
