@@ -16,7 +16,7 @@ import linecache
 import sys
 import tracemalloc
 
-from ballpit import bench
+from ballpit.cli import bench
 from ballpit.cli.allocator import keep_freed_memory
 
 FRAME = bench.SUBSTEPS * bench.DT

@@ -10,6 +10,10 @@ PyBullet, when installed (``pip install 'ballpit[bench]'``), runs the same pile 
     ballpit bench --workload settled --sizes 1000,10000,100000   # cost growth in a pile at rest
     ballpit bench --workload slopes --steps 2400   # the slopes demo headless, 10 s of it
     ballpit bench --workload seesaw --steps 1440   # the see-saw demo headless, its 6 s (a turning plank)
+    ballpit bench --peers --sizes 1000,3000 --csv peers.csv --plot peers.png   # against MuJoCo and PyBullet
+
+``--peers`` lands the grid in ballpit, MuJoCo and PyBullet at the same materials and the same 240 Hz,
+the engines taking turns over rounds (``peers/``).
 """
 
 from __future__ import annotations
@@ -19,7 +23,6 @@ import importlib.util
 import json
 import platform
 import resource
-import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -29,13 +32,13 @@ import numpy as np
 
 from .allocator import keep_freed_memory
 from .arguments import OneLineParser, count, one_line, positive
+from .children import run_child
+from .peers.landing import DT, RADIUS, pile_layout
 
-DT = 1 / 240  # s: both engines solve contacts this often; a "step" below is this much simulated time
+# DT: both engines solve contacts this often; a "step" below is this much simulated time.
 # ballpit takes the pile and settled workloads as its bundled piles do: 1/60 s frames of 4 soft
 # substeps (Box2D v3's soft step), so it too solves their contacts 240 times a second
 SUBSTEPS = 4
-RADIUS = 0.05
-SPACING = 0.11
 # The bundled demos timed as they are (workloads named after their scenes).
 DEMOS = ("slopes", "seesaw")
 
@@ -56,19 +59,6 @@ class Result:
     @property
     def ns_per_ball_step(self) -> float:
         return 1e9 * self.seconds / (self.steps * self.n)
-
-
-def pile_layout(n: int, seed: int = 1) -> tuple[np.ndarray, float]:
-    """``n`` ball centres on a grid 0.11 m apart above a floor at y = 0, and the box's half width."""
-    side = int(np.ceil(np.sqrt(n / max(1, round(n ** (1 / 3))))))
-    layers = int(np.ceil(n / (side * side)))
-    ix, iy, iz = np.meshgrid(np.arange(side), np.arange(layers), np.arange(side), indexing="ij")
-    cells = np.stack((ix.ravel(), iy.ravel(), iz.ravel()), axis=1)
-    cells = cells[np.lexsort((cells[:, 2], cells[:, 0], cells[:, 1]))][:n]  # fill bottom layers first
-    half = 0.5 * side * SPACING + RADIUS
-    jitter = np.random.default_rng(seed).uniform(-0.002, 0.002, (n, 3))
-    centres = (cells - [0.5 * (side - 1), 0.0, 0.5 * (side - 1)]) * SPACING + [0.0, 2 * RADIUS, 0.0] + jitter
-    return centres, half
 
 
 SETTLED_LAYERS = 4
@@ -121,35 +111,15 @@ def _ballpit_world(workload: str, n: int):
 
 
 def _pybullet_world(workload: str, n: int):
+    """The workload in a PyBullet client, each ball a rigid body (PyBullet's fast path for free bodies)."""
     import pybullet as p
 
+    from .peers.pybullet_engine import build_world
+
     client = p.connect(p.DIRECT)
-    p.setTimeStep(DT, physicsClientId=client)
-    p.setGravity(0, 0.0 if workload == "free" else -9.81, 0, physicsClientId=client)
-    sphere = p.createCollisionShape(p.GEOM_SPHERE, radius=RADIUS, physicsClientId=client)
-    if workload == "free":
-        centres = free_layout(n)
-    else:
-        centres, half = _box_layout(workload, n)
-        # y is up here too: the floor's normal is +y, walls are thin boxes.
-        floor = p.createCollisionShape(p.GEOM_PLANE, planeNormal=[0, 1, 0], physicsClientId=client)
-        p.createMultiBody(0, floor, physicsClientId=client)
-        wall_x = p.createCollisionShape(
-            p.GEOM_BOX, halfExtents=[0.05, 1.0, half + 0.1], physicsClientId=client
-        )
-        wall_z = p.createCollisionShape(
-            p.GEOM_BOX, halfExtents=[half + 0.1, 1.0, 0.05], physicsClientId=client
-        )
-        for shape, pos in (
-            (wall_x, [-half - 0.05, 1.0, 0]),
-            (wall_x, [half + 0.05, 1.0, 0]),
-            (wall_z, [0, 1.0, -half - 0.05]),
-            (wall_z, [0, 1.0, half + 0.05]),
-        ):
-            p.createMultiBody(0, shape, basePosition=pos, physicsClientId=client)
-    for c in centres:
-        body = p.createMultiBody(1.0, sphere, basePosition=c.tolist(), physicsClientId=client)
-        p.changeDynamics(body, -1, restitution=0.5, lateralFriction=0.5, physicsClientId=client)
+    centres, half = (free_layout(n), None) if workload == "free" else _box_layout(workload, n)
+    gravity = 0.0 if workload == "free" else 9.81
+    build_world(client, centres, half, restitution=0.5, friction=0.5, gravity=gravity)
     return lambda: p.stepSimulation(physicsClientId=client)
 
 
@@ -188,27 +158,16 @@ def measure_one(engine: str, workload: str, n: int, steps: int) -> Result:
 
 
 def run_isolated(engine: str, workload: str, n: int, steps: int, timeout: float) -> Result | None:
-    """``measure_one`` in a fresh interpreter; None (after one line on stderr) when it fails.
-
-    The child runs with ``-P``: the current directory is not put on its path, so a folder named
-    ``ballpit`` there (a clone, seen from the folder above it) cannot shadow the installed package.
-    """
-    cmd = [sys.executable, "-P", "-m", "ballpit.cli.bench", "--one", engine, workload, str(n), str(steps)]
-    label = f"{engine} {workload} N={n}"
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        print(f"ballpit bench: {label}: failed: no result within {timeout:g} s", file=sys.stderr)
-        return None
-    try:
-        if done.returncode != 0:
-            raise ValueError
-        return Result(**json.loads(done.stdout.strip().splitlines()[-1]))
-    except (ValueError, IndexError, TypeError):
-        why = [line.strip() for line in done.stderr.splitlines() if line.strip()]
-        reason = one_line(why[-1], limit=300) if why else f"exit status {done.returncode}, no output"
-        print(f"ballpit bench: {label}: failed: {reason}", file=sys.stderr)
-        return None
+    """``measure_one`` in a fresh interpreter (``children.py``); None (after one line on stderr) when
+    it fails."""
+    result = run_child("ballpit.cli.bench", ["--one", engine, workload, str(n), str(steps)], timeout)
+    if isinstance(result, dict):
+        try:
+            return Result(**result)
+        except TypeError:
+            result = f"an unexpected result: {one_line(str(result), limit=200)}"
+    print(f"ballpit bench: {engine} {workload} N={n}: failed: {result}", file=sys.stderr)
+    return None
 
 
 def _table(results: list[Result], reference: dict[tuple[str, int], Result]) -> str:
@@ -237,13 +196,8 @@ def figure(results: list[Result]) -> object:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogFormatterSciNotation
 
-    class PlainLog(LogFormatterSciNotation):
-        """Labels where matplotlib's log axis puts them, written 1.75, 0.5 or 10,000, not 1.75×10⁰."""
-
-        def __call__(self, x: float, pos: int | None = None) -> str:
-            return f"{x:,.10g}" if super().__call__(x, pos) else ""
+    from .plots import label_log_axis_plainly
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for engine in sorted({r.engine for r in results}):
@@ -259,14 +213,32 @@ def figure(results: list[Result]) -> object:
                     label=f"{engine} {workload}",
                 )
     for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_formatter(PlainLog())
-        axis.set_minor_formatter(PlainLog(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
+        label_log_axis_plainly(axis)
     ax.set_xlabel("balls")
     ax.set_ylabel("ms per step")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
     return fig
+
+
+PEER_SIZES = (1_000, 3_000, 10_000)
+PEER_STEPS = 480  # the first 2 s: the grid lands and settles
+PEER_ROUNDS = 3
+
+
+def _peers(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """``--peers``: the comparison lives in ``peers/``; here only the options are checked."""
+    for option in ("workload", "pybullet", "pybullet_up_to", "one"):
+        if getattr(args, option) not in (None, False, "all", "pile"):
+            parser.error(f"--{option.replace('_', '-')} does not go with --peers (it runs the landing grid)")
+    from .peers.report import run_peers
+
+    plot = Path(args.plot) if args.plot else None
+    sizes = args.sizes or list(PEER_SIZES)
+    return run_peers(
+        sizes, args.steps or PEER_STEPS, args.rounds or PEER_ROUNDS, args.timeout, args.csv, plot
+    )
 
 
 MAX_TIMEOUT = 1e6  # s (11.6 days): the wait for a child is kept in int milliseconds (at most 24.8 days)
@@ -317,12 +289,26 @@ def main(argv: list[str] | None = None) -> int:
         metavar="N",
         help="run PyBullet only up to N balls (its pile at rest grows as about N^1.6: hours at 100,000)",
     )
+    parser.add_argument(
+        "--peers",
+        action="store_true",
+        help="the landing grid in ballpit, MuJoCo and PyBullet (those installed), each at its fastest "
+        f"stable settings at 240 Hz, taking turns over --rounds; --steps defaults to {PEER_STEPS} (2 s), "
+        f"--sizes to {','.join(map(str, PEER_SIZES))} (10,000 takes the peers about 3 minutes a run)",
+    )
+    parser.add_argument("--rounds", type=count, help=f"with --peers: rounds (default {PEER_ROUNDS})")
+    parser.add_argument("--csv", type=Path, metavar="CSV", help="with --peers: write every run to CSV")
     parser.add_argument("--plot", metavar="PNG", help="write a log-log plot of step time against N")
     parser.add_argument("--timeout", type=_timeout, default=1800.0, help="seconds allowed per measurement")
     parser.add_argument(
         "--one", nargs=4, metavar=("ENGINE", "WORKLOAD", "N", "STEPS"), help=argparse.SUPPRESS
     )
     args = parser.parse_args(argv)
+    if args.peers:
+        return _peers(parser, args)
+    for option in ("rounds", "csv"):
+        if getattr(args, option) is not None:
+            parser.error(f"--{option} goes with --peers")
     if args.plot and not args.one:
         from .plots import MISSING_MATPLOTLIB, have_matplotlib
 

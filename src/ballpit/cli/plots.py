@@ -98,6 +98,19 @@ def energy_plot(path: Path | None, title: str) -> EnergyPlot | None:
     return None if path is None else EnergyPlot(path, title)
 
 
+def label_log_axis_plainly(axis: object) -> None:
+    """Label a log ``axis`` (``ax.xaxis``, ``ax.yaxis``) where matplotlib puts its labels, written
+    1.75, 0.5 or 10,000 rather than 1.75×10⁰ (major ticks, and minor ones within a decade or two)."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    class PlainLog(LogFormatterSciNotation):
+        def __call__(self, x: float, pos: int | None = None) -> str:
+            return f"{x:,.10g}" if super().__call__(x, pos) else ""
+
+    axis.set_major_formatter(PlainLog())
+    axis.set_minor_formatter(PlainLog(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
+
+
 def _figure() -> Figure:
     """An empty figure on an Agg canvas (no pyplot, no display, no global state)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from . import contact_model, exact, jacobi, solver
+from . import contact_model, exact, jacobi, resting, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
@@ -103,12 +103,18 @@ def in_waves(model: Model, state: State, c: ContactPoints, rows: ContactRows, re
 
 def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactRows,
                     min_normal_speed: np.ndarray, events: EventLog, now: float, *,
-                    jacobi_from: int = JACOBI_FROM) -> None:  # fmt: skip
+                    jacobi_from: int = JACOBI_FROM, interval: float | None = None) -> None:  # fmt: skip
     """Stop every contact still closing faster than its ``min_normal_speed`` allows (e = 0), solved over
     the island of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
 
     After ``in_waves`` these are the approaches slower than the restitution threshold, and whatever
     still arrives after MAX_WAVES waves. Inelastic impacts never add energy (checked as for a wave).
+
+    The sweeps may leave a ball pressed between heavier ones and a plane still closing on the plane
+    (Gauss–Seidel hands momentum through a light ball at about m_light/m_heavy a sweep). Those speeds
+    start the ``interval`` that follows, and explicit Euler moves a ball by its start velocity alone, so
+    no force over the interval can keep the ball out of the plane: planes win here too
+    (``resting.hold_by_planes``, over the interval's length).
     """
     if len(c) == 0:
         return
@@ -123,6 +129,17 @@ def stop_approaches(model: Model, state: State, c: ContactPoints, rows: ContactR
     imp = solver.solve(island, v, w, min_normal_speed[near], Impulses.zeros(len(island)),
                        model.solver_iterations, jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
                        jacobi_from=jacobi_from)  # fmt: skip
+    if interval is not None:
+        resting.hold_by_planes(
+            island,
+            c.gap[near],
+            model.spheres.radius,
+            v.copy(),
+            v,
+            min_normal_speed[near],
+            imp.normal,
+            interval,
+        )
     scale = _keep_energy(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]

@@ -196,6 +196,8 @@ WARM_START_SPAN = 0.5
 HOLD_SINK = 0.01
 # Sweeps over a held ball's plane contacts after the hold: exact after one against square walls.
 HOLD_PASSES = 3
+# The hold reaches this many layers of balls out from a held ball's planes (a chain pressing it).
+HOLD_LAYERS = 8
 
 # --- Sleeping (sleeping.py) -------------------------------------------------------------------------
 

@@ -153,12 +153,16 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         with prof.stage("contact rows"):
             batch = rows.contact_rows(model, state, touching)
         with prof.stage("penetration"):
-            penetration.remove_penetration(model, state, touching, batch)
+            moved = penetration.remove_penetration(model, state, touching, batch)
+        if moved:  # the interval is planned from where the balls are now, not from where they overlapped
+            contacts, touching, batch, pairs = _measure_again(step, pairs, free, remaining, touching, batch)
         min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
         with prof.stage("impacts"):  # arrivals bounce in waves; then slower approaches stop
             impacts.in_waves(model, state, touching, batch, step.restitution_threshold, min_normal_speed,
                              step.events, now)  # fmt: skip
-            impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now)
+            impacts.stop_approaches(
+                model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
+            )
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, step.forces)
         with prof.stage("resting solve"):
@@ -169,7 +173,7 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again
         # for the rest of this step and the next ones (they replace the kept pairs).
         with prof.stage("pairs"):
-            if (not first or push is not None) and pairs.escaped(model, state, lin, remaining):
+            if (not first or push is not None or moved) and pairs.escaped(model, state, lin, remaining):
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
                 pairs = step.pairs.renew(model, state, remaining, ahead, lin, free)
                 contacts = narrowphase.contact_points(model, state, pairs)
@@ -182,6 +186,40 @@ def split_at_impacts(step: Step, contacts: ContactPoints, pairs: KeptPairs,
         step.integrate(push, h)
         step.events.close_interval(h / remaining)
         elapsed = dt if h >= remaining else elapsed + h
+
+
+Measured = tuple[ContactPoints, ContactPoints, rows.ContactRows, KeptPairs]
+
+
+def _measure_again(
+    step: Step,
+    pairs: KeptPairs,
+    free: np.ndarray,
+    remaining: float,
+    touching: ContactPoints,
+    batch: rows.ContactRows,
+) -> Measured:
+    """After the push-apart moved balls: the kept pairs measured again (found again first if a ball was
+    moved out of the box they were found from), the ``touching`` contacts and their rows with the
+    pairs the move brought into contact added after them.
+
+    A ball pushed out of an overlap may now touch a wall it was far from (a small ball inside a big
+    one beside a wall is pushed to it): planned from the gaps measured before the move, the interval
+    would let it fly on through that wall. The contacts that touched before the move stay as they were
+    measured, so a move that brings nothing new into contact solves what it solved before."""
+    model, state, prof = step.model, step.state, step.profile
+    with prof.stage("pairs"):
+        if pairs.escaped(model, state, free, remaining):
+            ahead = remaining + (BROAD_PHASE_STEPS - 1) * step.dt
+            pairs = step.pairs.renew(model, state, remaining, ahead, free, free)
+    with prof.stage("narrow phase"):
+        contacts = narrowphase.contact_points(model, state, pairs)
+    met = (contacts.gap < contact_slop(model)) & ~np.isin(contacts.keys(), touching.keys())
+    if met.any():
+        touching = ContactPoints.concatenate([touching, contacts.subset(met)])
+        with prof.stage("contact rows"):
+            batch = rows.contact_rows(model, state, touching)
+    return contacts, touching, batch, pairs
 
 
 def finish_conservatively(step: Step, contacts: ContactPoints, push: ConstantPerBall | None,
@@ -321,8 +359,9 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
     if (frame.largest_move[cols] > SUBSTEP_TRAVEL * r).any():
         return "a ball moved farther than SUBSTEP_TRAVEL radii in a substep"
     smaller = np.where(c.b < n, np.minimum(radius[c.a], np.append(radius, 0.0)[c.b]), radius[c.a])
-    if (frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any():
-        return DEEPER
+    # a solved contact that overlapped deeper is said last: a frame kept in spite of it (the last try)
+    # must still have met every pair it left out
+    deeper = bool((frame.least_separation < np.minimum(c.gap, 0.0) - DEEP_OVERLAP * smaller).any())
     # how far each ball got from where it started (the others flew straight)
     far = np.zeros(n + 1)
     moved = state.body[:, X] - before[:, X]
@@ -350,15 +389,14 @@ def frame_doubt(step: Step, contacts: ContactPoints, solved: np.ndarray, c: Cont
         out = out.subset(near)
         start = np.minimum(out.gap, 0.0)
         out.gap = _gap_from(out, before, model, state) - start
-    if len(out) == 0:
-        return None
-    on_plane = out.kind == SPHERE_PLANE
-    smaller = np.where(
-        on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
-    )
-    if (out.gap < -DEEP_OVERLAP * smaller).any():
-        return "a pair left out overlaps deeper than DEEP_OVERLAP"
-    return None
+    if len(out):
+        on_plane = out.kind == SPHERE_PLANE
+        smaller = np.where(
+            on_plane, radius[out.a], np.minimum(radius[out.a], radius[np.where(on_plane, 0, out.other)])
+        )
+        if (out.gap < -DEEP_OVERLAP * smaller).any():
+            return "a pair left out overlaps deeper than DEEP_OVERLAP"
+    return DEEPER if deeper else None
 
 
 def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) -> np.ndarray:
