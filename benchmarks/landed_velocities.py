@@ -14,7 +14,7 @@ import argparse
 import numpy as np
 
 import ballpit
-from ballpit.bench import RADIUS, pile_layout
+from ballpit.cli.bench import RADIUS, pile_layout
 
 
 def main() -> None:
