@@ -1,6 +1,7 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
 # `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min).
-# demo installs only what ballpit itself needs; test adds the test tools (pytest, ruff, scipy, ...).
+# demo installs what ballpit itself needs and PyAV (F9 records MP4); test adds the test tools (pytest, ruff,
+# scipy, ...).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -9,7 +10,7 @@ PY := $(VENV)/bin/python
 
 $(VENV)/.ballpit: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e .
+	$(PY) -m pip install --quiet -e '.[video]'
 	touch $@
 
 $(VENV)/.installed: $(VENV)/.ballpit

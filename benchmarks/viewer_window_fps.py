@@ -18,6 +18,10 @@ Per scene, medians over the runs of:
 - with ``--threads``, the CPU each kind of thread used while the pile landed, in cores: the physics
   thread, the window's (main) thread, llvmpipe's rasteriser threads and the rest;
 - with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end;
+- with ``--video S``, F9 at X and again once the video holds S seconds (S·30 frames): the landing
+  columns then cover the recording, and ``video_frames``, ``video_seconds`` are what ffprobe reads
+  from the file, ``read_ms`` the window's time per video frame reading pixels back, ``encode_wait``
+  the share of the recording the window waited for the encoder (its queue full).
 - ``panel_ms_before`` and ``panel_ms_land``: the mean time the panel took per frame (building it with
   ImGui and handing its triangles to GL, on the window's thread) before X and while the scene lands;
   ``panel_cpu_ms_*`` the same in the window thread's CPU time (without the waits for the GIL and for a
@@ -39,7 +43,7 @@ import sys
 import time
 
 CHILD = r"""
-import json, os, re, statistics, sys, time
+import json, os, re, statistics, subprocess, sys, time
 import pyglet
 from pyglet.window import key
 from ballpit.scene import default_scene_path
@@ -47,7 +51,8 @@ from ballpit.viewer.app import Viewer
 
 name, seconds, quality, escape = sys.argv[1], float(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
 width, height, land = int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
-panel = sys.argv[8] == "on"
+video = float(sys.argv[8])
+panel = sys.argv[9] == "on"
 path = default_scene_path().with_name(name + ".toml")
 viewer = Viewer(size=(width, height), scene_path=path, quality=quality, panel=panel)
 sim = viewer.sim
@@ -122,6 +127,8 @@ def tick(_dt):
         viewer.panel.seconds.clear()
         viewer.panel.cpu_seconds.clear()
         viewer.window.dispatch_event("on_key_press", key.X, 0)
+        if video:
+            viewer.window.dispatch_event("on_key_press", key.F9, 0)
         idle = getattr(viewer.physics, "idle_seconds", 0.0)
         captured = getattr(viewer.physics, "capture_seconds", 0.0)
         state.update(phase="landing", mark=mark(), cpu=thread_cpu(), samples=[], sample_at=now + 0.75,
@@ -132,7 +139,20 @@ def tick(_dt):
             state["sample_at"] = now + 0.25
             state["samples"].append(hud_factor())
         simulated = sim_time()
-        if simulated >= land or now - t > 6 * land + 5:
+        recorded = viewer.video.writer.frames if video and viewer.video.writer is not None else 0
+        done = recorded >= round(video * viewer.video.fps) if video else simulated >= land
+        if done or now - t > 6 * max(land, video) + 5:
+            if video:
+                writer = viewer.video.writer
+                viewer.window.dispatch_event("on_key_press", key.F9, 0)
+                probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-show_entries",
+                                        "stream=nb_read_frames,duration", "-of", "json",
+                                        str(viewer.video.last_video.path)], capture_output=True, text=True)
+                stream = json.loads(probe.stdout)["streams"][0]
+                out["video_frames"] = int(stream["nb_read_frames"])
+                out["video_seconds"] = float(stream["duration"])
+                out["read_ms"] = viewer.video.read_seconds / max(recorded, 1) * 1e3
+                out["encode_wait"] = writer.wait_seconds / (now - t)
             wall = now - t
             out["land_fps"] = (viewer.frames - frames) / wall
             out["panel_ms_land"] = viewer.panel.cost_ms() if panel else None
@@ -196,6 +216,7 @@ print("RESULT " + json.dumps({"land_rtf": world.time / wall, "physics_cpu_per_si
 COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fps_after_x",
            "steps_per_second", "real_time_factor", "panel_ms_before", "panel_ms_land"]  # fmt: skip
 COLUMNS += ["panel_cpu_ms_before", "panel_cpu_ms_land"]
+VIDEO_COLUMNS = ["video_frames", "video_seconds", "read_ms", "encode_wait"]
 THREAD_COLUMNS = ["cpu_physics", "cpu_main", "cpu_llvmpipe", "cpu_other", "physics_cpu_per_sim_s",
                   "cpu_physics_queued", "physics_asleep", "physics_idle", "physics_capture"]  # fmt: skip
 
@@ -205,7 +226,8 @@ def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: di
     """One viewer process on ``scene`` (or, ``headless``, its landing stepped with no window); returns
     its measurements."""
     command = [sys.executable, "-c", CHILD, scene, str(args.seconds), args.quality,
-               "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land)]  # fmt: skip
+               "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land),
+               str(args.video)]  # fmt: skip
     command.append(args.panel)
     if headless:
         command = [sys.executable, "-c", HEADLESS, scene, str(args.land)]
@@ -229,6 +251,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--threads", action="store_true", help="CPU per kind of thread while it lands")
     parser.add_argument("--env", action="append", default=[], help="NAME=VALUE for the viewer process")
     parser.add_argument("--json", action="store_true", help="also print every run's numbers")
+    parser.add_argument(
+        "--video",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="record S seconds of MP4 (F9) from X; the landing columns cover it",
+    )
     parser.add_argument("--headless", action="store_true", help="also step each landing with no window")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.lower().split("x"))
@@ -247,6 +276,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{time.strftime('%Y-%m-%d %H:%M')}, {size[0]}x{size[1]}, medians of {args.runs} runs, "
           f"quality {args.quality}, panel {args.panel}{extra}, load average {load} at the start")  # fmt: skip
     cols = COLUMNS + (THREAD_COLUMNS if args.threads else []) + (["escape_seconds"] if args.escape else [])
+    cols += VIDEO_COLUMNS if args.video else []
     print("| scene | " + " | ".join(cols) + " |\n|---|" + "---|" * len(cols))
     for scene, runs in results.items():
         cells = []

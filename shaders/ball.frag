@@ -5,6 +5,7 @@
 
 #extension GL_ARB_conservative_depth : enable
 #include "common.glsl"
+#include "casters.glsl"
 
 #ifdef GL_ARB_conservative_depth
 layout(depth_greater) out float gl_FragDepth;   // see ball.vert: the sphere is behind its quad
@@ -74,6 +75,7 @@ void main() {
     white_amount = max(white_amount, cap);
     vec3 albedo = mix(v_color, WHITE, white_amount);
 
-    vec3 color = fog(shade(albedo, n, hit, 48.0, 0.35), hit);
+    float sun = dot(n, u_sun_direction) > 0.0 ? plane_shadow(hit, -1) : 1.0;  // under a slope: its shade
+    vec3 color = fog(shade_lit(albedo, n, hit, 48.0, 0.35, sun, 1.0), hit);
     frag_color = vec4(color, (u_multisample > 0.5 ? coverage : 1.0) * u_alpha);
 }

@@ -40,10 +40,6 @@ vec3 shade_lit(vec3 albedo_srgb, vec3 n, vec3 position, float shininess, float s
     return to_srgb(albedo * (sky + SUN_COLOR * diffuse * sun) + SUN_COLOR * highlight * sun);
 }
 
-vec3 shade(vec3 albedo_srgb, vec3 n, vec3 position, float shininess, float specular) {
-    return shade_lit(albedo_srgb, n, position, shininess, specular, 1.0, 1.0);
-}
-
 // Exponential-squared fog towards the background with distance from the eye.
 vec3 fog(vec3 color_srgb, vec3 position) {
     float d = length(position - u_eye) * u_fog_density;

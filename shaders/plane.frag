@@ -1,16 +1,21 @@
 #version 330 core
 // Two-sided planes: a checker of 1 m cells with anti-aliased grid lines, a bright rim along the edges
 // of finite planes so they read from any side, and fog with distance (the infinite ground fades into
-// the background). The front face (the side the normal points to) is opaque. The back face is a wall
-// you look through (the near wall of a closed box seen from outside): the renderer draws it after the
-// balls, blended, so it is a faint, darker tint with its grid and rim kept visible. The selected plane
-// (clicked in the viewer) has a wide amber rim, or an amber tint if it is infinite and has no rim.
+// the background). The front face (the side the normal points to) is opaque. So is the back of a solid
+// plane (a floor or a slope: renderer.py), lit as a face of its own (two-sided lighting: the normal
+// turned towards the eye) in its own colour. The back of any other plane is a wall you look through
+// (the near wall of a closed box seen from outside): the renderer draws it after the balls, blended, so
+// it is a faint, darker tint with its grid and rim kept visible. The selected plane (clicked in the
+// viewer) has a wide amber rim, or an amber tint if it is infinite and has no rim.
 //
-// The balls shade the front faces: each one near the ray towards the sun casts a soft-edged shadow,
+// The balls shade the opaque faces: each one near the ray towards the sun casts a soft-edged shadow,
 // and each one close by hides part of the sky (contact darkening). The renderer bins the balls in a
-// grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only its own cell.
+// grid on a plane perpendicular to the sun (see shadows.py); a fragment reads only its own cell. The
+// solid finite planes cast soft-edged shadows too (casters.glsl), so the ground under a slope is in its
+// shade, and a ball's shadow falls on the first thing below it, not through the slope as well.
 
 #include "common.glsl"
+#include "casters.glsl"
 
 in vec3 v_world;
 in vec2 v_local;
@@ -19,11 +24,14 @@ flat in vec2 v_half_size;
 flat in vec3 v_normal;
 flat in vec3 v_color;
 flat in float v_selected;
+flat in float v_solid;
+flat in int v_index;
 
 uniform samplerBuffer u_shadow_balls;   // centre xyz, radius; grouped by cell, nearest the sun first
 uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, cells[k].y)
 uniform vec2 u_shadow_shape;            // cells along u and v; (0, 0): no shadows
 uniform float u_shadow_reach;           // ball radii from the centre where a ball's shading ends
+uniform float u_back_pass;              // back faces drawn now: 1 the solid ones, 0 the see-through ones
 
 out vec4 frag_color;
 
@@ -46,7 +54,6 @@ float grid(vec2 p, float spacing, float width_pixels) {
     return on * (1.0 - smoothstep(0.15, 0.5, density));
 }
 
-const float SUN_RADIUS = 0.035;        // radians: a disc a little wider than the real sun, soft edges
 
 // The balls near this point's ray towards the sun: the fraction of the sun it sees (x) and the
 // fraction of the ambient light the close ones leave (y). Its cell holds every ball that can shade it.
@@ -80,13 +87,16 @@ vec2 ball_shading(vec3 p, vec3 n, vec2 g) {
 }
 
 void main() {
+    bool back = !gl_FrontFacing;
+    if (back && (v_solid > 0.5) != (u_back_pass > 0.5)) discard;  // drawn in the other back pass
+    bool see_through = back && v_solid < 0.5;
     vec3 n = gl_FrontFacing ? v_normal : -v_normal;
     vec2 cell = floor(v_local);
     float checker = mod(cell.x + cell.y, 2.0);
     vec3 albedo = v_color * mix(0.90, 1.0, checker);
     float lines = grid(v_local, 1.0, 1.0);
     albedo = mix(albedo, albedo * 0.65, lines);
-    if (!gl_FrontFacing) albedo *= 0.75;
+    if (see_through) albedo *= 0.75;
 
     // edge band of finite planes
     vec2 inside = v_half_size - abs(v_local);
@@ -98,11 +108,12 @@ void main() {
     if (v_selected > 0.5 && v_half_size.x > 1.0e5) albedo = mix(albedo, SELECTED_COLOR, 0.35);
 
     float alpha = 1.0;
-    if (!gl_FrontFacing) {
+    if (see_through) {
         alpha = mix(mix(BACK_ALPHA, BACK_GRID_ALPHA, lines), BACK_EDGE_ALPHA, edge);
     }
 
-    vec2 shading = gl_FrontFacing ? ball_shading(v_world, n, v_shadow_grid) : vec2(1.0);
+    vec2 shading = see_through ? vec2(1.0) : ball_shading(v_world, n, v_shadow_grid);
+    if (!see_through && dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, plane_shadow(v_world, v_index));
     vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

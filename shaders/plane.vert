@@ -1,14 +1,16 @@
 #version 330 core
 // Planes as quads. Each vertex carries its plane-local coordinates (metres from the centre along the
 // plane's width and depth axes) for the grid, the plane's half extents for the edge band, its normal
-// and its colour (bounciness). Each plane is 6 consecutive vertices, so gl_VertexID / 6 is its index;
-// the selected one (u_selected, -1 for none) is flagged for a highlighted rim.
+// its colour (bounciness) and whether it is solid from behind (a floor or slope, see renderer.py). Each
+// plane is 6 consecutive vertices, so gl_VertexID / 6 is its index; the selected one (u_selected, -1 for
+// none) is flagged for a highlighted rim.
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec2 a_local;
 layout(location = 2) in vec2 a_half_size;   // a very large value for an infinite plane
 layout(location = 3) in vec3 a_normal;
 layout(location = 4) in vec3 a_color;
+layout(location = 5) in float a_solid;      // 1: opaque from both sides; 0: see-through from behind
 
 uniform mat4 u_view_projection;
 uniform vec3 u_shadow_axis_u;           // the sun's grid (see plane.frag)
@@ -24,6 +26,8 @@ flat out vec3 v_normal;
 flat out vec3 v_color;
 out vec2 v_shadow_grid;  // the position's grid coordinates: affine, so interpolating them is exact
 flat out float v_selected;
+flat out float v_solid;
+flat out int v_index;
 
 void main() {
     v_world = a_position;
@@ -34,5 +38,7 @@ void main() {
     v_normal = a_normal;
     v_color = a_color;
     v_selected = abs(float(gl_VertexID / 6) - u_selected) < 0.5 ? 1.0 : 0.0;
+    v_solid = a_solid;
+    v_index = gl_VertexID / 6;
     gl_Position = u_view_projection * vec4(a_position, 1.0);
 }

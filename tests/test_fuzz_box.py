@@ -7,13 +7,24 @@ overlap each other and the slope), at up to 52 m/s; gravity with up to 24 m/s² 
 at 1/60, 1/120 or 1/240 s. Whatever the engine does inside a step, a ball's centre that ends a step
 outside the box has passed through a wall.
 
-The suite runs a fixed, derandomised set of examples (6 for each property, BALLPIT_FUZZ_EXAMPLES)
-plus the failures longer searches found, kept as ``@example`` cases. A longer search, for instance:
+The wider search (``Turned``, below) turns the box (six infinite walls, or six squares meeting at their
+edges) and draws the scenes that broke the engine before: explicit Euler at 0.05–0.2 s a step, balls
+pressed by gravity into an edge or a corner, 10–40 balls at up to 1,000 m/s, small balls starting
+inside a big one beside a wall (overlaps up to a scene's ``overlap_tolerance`` of 6 cm), a sleeping
+row or heap struck by a ball thrown at up to 1,000 m/s, and chains of balls 2–100 times heavier each
+against a wall. After every step: no state is non-finite, no ball's centre is beyond a wall, and an
+elastic frictionless box integrated exactly (RK2, RK4, or no gravity) gains no energy beyond rounding.
+
+The suite runs a fixed, derandomised set of examples (6 for each property of the first box, 3 for each
+of the wider search, BALLPIT_FUZZ_EXAMPLES) plus the failures longer searches found, kept as
+``@example`` cases. A longer search, for instance:
 
     BALLPIT_FUZZ_EXAMPLES=3000 BALLPIT_FUZZ_RANDOM=1 python -m pytest tests/test_fuzz_box.py -x
 
 (``BALLPIT_FUZZ_RANDOM=1`` draws new examples each run instead of the suite's fixed ones;
-``BALLPIT_FUZZ_SPLIT=1`` splits every step at impacts, ``crowd_limit`` inf, to search that path alone.)
+``BALLPIT_FUZZ_SPLIT=1`` splits every step at impacts, ``crowd_limit`` inf, to search that path alone;
+``BALLPIT_FUZZ_LONG=1`` is the long search: 500 new examples a property unless BALLPIT_FUZZ_EXAMPLES
+says otherwise, shrunk when they fail; give each run its own ``--hypothesis-seed``.)
 """
 
 from __future__ import annotations
@@ -31,12 +42,14 @@ from hypothesis import HealthCheck, Phase, example, given, settings
 from hypothesis import strategies as st
 
 import ballpit
+from ballpit.physics.integrators import INTEGRATOR_NAMES
 from ballpit.scene import read_scene
 
 pytestmark = pytest.mark.slow  # a hypothesis search over whole runs: `make test`, not `make check`
 
-EXAMPLES = int(os.environ.get("BALLPIT_FUZZ_EXAMPLES", "6"))
-FIXED = os.environ.get("BALLPIT_FUZZ_RANDOM") != "1"
+LONG = os.environ.get("BALLPIT_FUZZ_LONG") == "1"  # the long search: many new examples, shrunk
+EXAMPLES = int(os.environ.get("BALLPIT_FUZZ_EXAMPLES", "500" if LONG else "6"))
+FIXED = os.environ.get("BALLPIT_FUZZ_RANDOM") != "1" and not LONG
 SPLIT = os.environ.get("BALLPIT_FUZZ_SPLIT") == "1"  # every step split at impacts (crowd_limit inf)
 FUZZ = settings(
     max_examples=EXAMPLES,
@@ -48,19 +61,15 @@ FUZZ = settings(
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
     print_blob=True,
 )
+# the wider search's properties run fewer fixed examples in the suite (each runs 20–40 steps of a scene)
+WIDE = settings(FUZZ, max_examples=EXAMPLES if LONG or "BALLPIT_FUZZ_EXAMPLES" in os.environ else 3)
 STEPS = 60  # the split-at-impacts escape this search first found came at step 37
 
 
 @dataclass(frozen=True)
-class Box:
-    """One generated scene: a cube of side 2·half centred on the origin, its slope and its balls."""
+class Balls:
+    """What every generated scene has: gravity, the integrator and its step, and the balls."""
 
-    half: float
-    wall_restitution: float
-    wall_friction: float
-    slope_rotation: tuple[float, float, float]
-    slope_size: float
-    slope_spin: tuple[float, float, float]
     gravity: tuple[float, float, float]
     integrator: str
     dt: float
@@ -69,6 +78,18 @@ class Box:
     radii: tuple[float, ...]
     masses: tuple[float, ...]
     restitution: float
+
+
+@dataclass(frozen=True)
+class Box(Balls):
+    """One generated scene: a cube of side 2·half centred on the origin, its slope and its balls."""
+
+    half: float
+    wall_restitution: float
+    wall_friction: float
+    slope_rotation: tuple[float, float, float]
+    slope_size: float
+    slope_spin: tuple[float, float, float]
     crowd_limit: float | None = None  # inf: every step split at impacts (None: the world's default)
 
     def world(self) -> ballpit.World:
@@ -374,3 +395,418 @@ def test_a_scene_saved_mid_run_loads_back_with_the_same_balls(box, at):
 def _digest(contacts, world) -> bytes:
     parts = (contacts.time, contacts.a, contacts.b, contacts.point, contacts.impulse, world.state.body)
     return b"".join(np.ascontiguousarray(p).tobytes() for p in parts)
+
+
+# ---------------------------------------------------------------------------------------------------
+# The wider search: turned boxes of six walls (infinite, or squares meeting at their edges) and the
+# scenes that broke the engine in 2026-12-04's attack. Each example says where its balls are in the
+# box's own frame; the box is turned about its centre (the origin) by ``turn``.
+
+
+@dataclass(frozen=True)
+class Turned(Balls):
+    """A closed cube of side 2·half, turned by ``turn`` (extrinsic x, y, z degrees), and its balls,
+    placed in the cube's frame (gravity too). ``strike`` (radius, mass, position, velocity in the cube's
+    frame) is a ball thrown once the others have fallen asleep (``sleep``)."""
+
+    half: float
+    turn: tuple[float, float, float]
+    squares: bool
+    wall_restitution: float
+    wall_friction: float
+    friction: float = 0.0
+    substeps: int = 1
+    sleep: bool = False
+    strike: tuple[float, float, tuple[float, float, float], tuple[float, float, float]] | None = None
+    steps: int = 40
+
+    def rotation(self) -> np.ndarray:
+        ax, ay, az = np.radians(self.turn)
+        rx = np.array([[1, 0, 0], [0, math.cos(ax), -math.sin(ax)], [0, math.sin(ax), math.cos(ax)]])
+        ry = np.array([[math.cos(ay), 0, math.sin(ay)], [0, 1, 0], [-math.sin(ay), 0, math.cos(ay)]])
+        rz = np.array([[math.cos(az), -math.sin(az), 0], [math.sin(az), math.cos(az), 0], [0, 0, 1]])
+        return rz @ ry @ rx
+
+    def world(self) -> ballpit.World:
+        turn = self.rotation()
+        world = ballpit.World(
+            gravity=turn @ np.array(self.gravity),
+            integrator=self.integrator,
+            sleep=self.sleep,
+            substeps=self.substeps,
+        )
+        for axis in range(3):
+            for sign in (-1.0, 1.0):
+                face = np.eye(3)[axis] * sign  # the wall's outward direction in the cube's frame
+                if self.squares:
+                    # the +y square turned so that its normal faces in (−face), then with the cube
+                    rotation = _euler_xyz(turn @ _facing(-face))
+                    plane = world.add_plane(
+                        position=turn @ (face * self.half),
+                        rotation=rotation,
+                        size=2.0 * self.half,
+                        restitution=self.wall_restitution,
+                        friction=self.wall_friction,
+                    )
+                    assert np.allclose(plane.normal, -(turn @ face), atol=1e-9)
+                else:
+                    world.add_plane(
+                        position=turn @ (face * self.half),
+                        normal=-(turn @ face),
+                        restitution=self.wall_restitution,
+                        friction=self.wall_friction,
+                    )
+        if self.positions:
+            world.add_spheres(
+                np.array(self.positions) @ turn.T,
+                radius=np.array(self.radii),
+                mass=np.array(self.masses),
+                velocity=np.array(self.velocities) @ turn.T,
+                restitution=self.restitution,
+                friction=self.friction,
+            )
+        return world
+
+    def throw(self, world: ballpit.World) -> None:
+        """Add the striking ball (``strike``) to ``world``."""
+        radius, mass, at, velocity = self.strike
+        turn = self.rotation()
+        world.add_sphere(
+            position=turn @ np.array(at),
+            radius=radius,
+            mass=mass,
+            velocity=turn @ np.array(velocity),
+            restitution=self.restitution,
+            friction=self.friction,
+        )
+
+    def beyond(self, world: ballpit.World) -> np.ndarray:
+        """How far each ball's centre is beyond the nearest wall, in the cube's frame (m; ≤ 0 inside,
+        NaN for a ball that is not finite)."""
+        local = np.asarray(world.spheres.positions) @ self.rotation()
+        return np.abs(local).max(axis=1) - self.half
+
+    def elastic(self) -> bool:
+        """Whether no energy may be lost or gained: elastic, frictionless, and integrated exactly under
+        gravity (RK2 and RK4) or with no gravity at all."""
+        exact_path = self.integrator in ("rk2", "rk4") or not any(self.gravity)
+        smooth = self.wall_friction == 0.0 and self.friction == 0.0
+        return exact_path and smooth and self.wall_restitution == 1.0 and self.restitution == 1.0
+
+
+def _facing(normal: np.ndarray) -> np.ndarray:
+    """A rotation taking +y to ``normal`` (one of ±x, ±y, ±z), by quarter and half turns."""
+    x, y, z = normal
+    if y:
+        return np.diag([1.0, y, y])  # +y: identity; −y: a half turn about x
+    if x:  # a quarter turn about z: +y -> ∓x
+        return np.array([[0.0, x, 0.0], [-x, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    return np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -z], [0.0, z, 0.0]])  # about x: +y -> ±z
+
+
+def _euler_xyz(m: np.ndarray) -> tuple[float, float, float]:
+    """Extrinsic x, y, z angles (degrees) of the rotation matrix ``m`` = Rz·Ry·Rx."""
+    sy = -m[2, 0]
+    if abs(sy) < 1.0 - 1e-12:
+        ay = math.asin(sy)
+        ax = math.atan2(m[2, 1], m[2, 2])
+        az = math.atan2(m[1, 0], m[0, 0])
+    else:  # gimbal lock: fold z into x
+        ay = math.copysign(math.pi / 2, sy)
+        ax = math.atan2(-m[1, 2], m[1, 1])
+        az = 0.0
+    return tuple(math.degrees(a) for a in (ax, ay, az))
+
+
+def _turn(draw) -> tuple[float, float, float]:
+    return draw(st.sampled_from([(0.0, 0.0, 0.0), None])) or draw(_vector(45.0))
+
+
+def _corner_gravity(draw, into: np.ndarray) -> tuple[float, float, float]:
+    """Gravity pressing into the corner or edge ``into`` (a vector of 0 and ±1 in the cube's frame)."""
+    g = np.array([draw(st.floats(2.0, 30.0)) for _ in range(3)]) * into
+    return tuple(float(c) for c in g)
+
+
+def _pressed(draw, half: float, into: np.ndarray, radii: list[float], heaps: bool) -> list:
+    """Positions of balls pressed into the corner or edge ``into``: each touches the walls it points
+    into, stacked along the edge or heaped against the corner (``heaps``: the next ball sits on the
+    last one, along −gravity, a little apart)."""
+    positions, last = [], None
+    for r in radii:
+        # touching the walls of ``into``, anywhere along the other axes
+        p = np.array([draw(st.floats(-(half - r), half - r)) for _ in range(3)])
+        p = np.where(into != 0, into * (half - r), p)
+        if heaps and last is not None:
+            lp, lr = last
+            up = -into / np.linalg.norm(into)
+            p = lp + up * (lr + r) * draw(st.sampled_from([1.0, 1.001, 1.1]))
+            p = np.clip(p, -(half - r), half - r)
+        positions.append(tuple(float(c) for c in p))
+        last = (p, r)
+    return positions
+
+
+def _into(draw) -> np.ndarray:
+    """A corner (three walls) or an edge (two) of the cube, as signs per axis."""
+    signs = np.array([draw(st.sampled_from([-1.0, 1.0])) for _ in range(3)])
+    if draw(st.booleans()):  # an edge: one axis free
+        signs[draw(st.integers(0, 2))] = 0.0
+    return signs
+
+
+def _corner_box(draw, half: float, into: np.ndarray, integrators, timesteps, elastic: bool) -> dict:
+    """A turned cube with gravity pressing into its corner or edge ``into``, one of ``integrators`` at
+    one of ``timesteps``; walls and balls elastic and frictionless, or each drawn dead to half so."""
+    dead = st.sampled_from([0.0, 0.5])
+    return dict(
+        half=half,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0 if elastic else draw(dead),
+        wall_friction=0.0 if elastic else draw(dead),
+        gravity=_corner_gravity(draw, into),
+        integrator=draw(st.sampled_from(integrators)),
+        dt=draw(st.sampled_from(timesteps)),
+        restitution=1.0 if elastic else draw(dead),
+        friction=0.0 if elastic else draw(dead),
+    )
+
+
+@st.composite
+def pressed_into_corners(
+    draw, integrators=("euler", "rk2", "rk4", "symplectic"), timesteps=(1 / 60, 0.05, 0.1)
+) -> Turned:
+    """1–6 balls of 0.1 mm to 5 cm pressed by gravity into an edge or a corner of a turned box, some
+    moving at up to 10 m/s, heavy or light, elastic and frictionless or not, at large steps."""
+    half = draw(st.sampled_from([1.0, 0.3]))
+    n = draw(st.integers(1, 6))
+    radii = draw(st.lists(st.sampled_from([1e-4, 1e-3, 5e-3, 0.02, 0.05]), min_size=n, max_size=n))
+    into = _into(draw)
+    positions = _pressed(draw, half, into, radii, draw(st.booleans()))
+    speed = draw(st.sampled_from([0.0, 1.0, 10.0]))
+    elastic = draw(st.booleans())
+    return Turned(
+        **_corner_box(draw, half, into, integrators, timesteps, elastic),
+        positions=tuple(positions),
+        velocities=tuple(draw(_vector(speed)) for _ in range(n)) if speed else ((0.0, 0.0, 0.0),) * n,
+        radii=tuple(radii),
+        masses=tuple(draw(st.lists(st.sampled_from([0.001, 0.1, 1.0, 10.0]), min_size=n, max_size=n))),
+    )
+
+
+@st.composite
+def fast_in_turned_squares(draw) -> Turned:
+    """10–40 balls at up to 1,000 m/s in a turned box of six squares (or walls), RK2, RK4 or Euler at
+    up to 0.1 s a step, elastic and frictionless."""
+    half = 1.0
+    n = draw(st.integers(10, 40))
+    radii = draw(st.lists(st.floats(0.005, 0.08), min_size=n, max_size=n))
+    positions = tuple(tuple(draw(st.floats(-(half - r), half - r)) for _ in range(3)) for r in radii)
+    speed = draw(st.sampled_from([100.0, 1000.0]))
+    return Turned(
+        half=half,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0,
+        wall_friction=0.0,
+        gravity=(0.0, -9.81, 0.0),
+        integrator=draw(st.sampled_from(["rk2", "rk4", "euler"])),
+        dt=draw(st.sampled_from([1 / 60, 0.05, 0.1])),
+        positions=positions,
+        velocities=tuple(draw(_vector(speed)) for _ in range(n)),
+        radii=tuple(radii),
+        masses=tuple(draw(st.lists(st.floats(0.01, 2.0), min_size=n, max_size=n))),
+        restitution=1.0,
+        steps=20,
+    )
+
+
+def _floor_box(draw, elastic: bool) -> dict:
+    """A turned 2 m cube under plain gravity, any integrator at 1/240 or 1/60 s, its walls and balls
+    elastic and frictionless or half so."""
+    return dict(
+        half=1.0,
+        turn=_turn(draw),
+        squares=draw(st.booleans()),
+        wall_restitution=1.0 if elastic else 0.5,
+        wall_friction=0.0 if elastic else 0.5,
+        gravity=(0.0, -9.81, 0.0),
+        integrator=draw(st.sampled_from(INTEGRATOR_NAMES)),
+        dt=draw(st.sampled_from([1 / 240, 1 / 60])),
+        restitution=1.0 if elastic else 0.5,
+        friction=0.0 if elastic else 0.5,
+    )
+
+
+@st.composite
+def overlapping_starts(draw) -> Turned:
+    """A big ball (up to 100 kg) touching or near a wall of a turned box, and 1–4 small balls starting
+    inside its shell, overlapping it by up to 6 cm (a scene's ``overlap_tolerance``), moving at up to
+    20 m/s; any integrator."""
+    half = 1.0
+    big = draw(st.floats(0.1, 0.4))
+    into = _into(draw)
+    centre = np.where(into != 0, into * (half - big - draw(st.sampled_from([0.0, 0.0, 0.01]))), 0.0)
+    radii, positions = [big], [tuple(float(c) for c in centre)]
+    for _ in range(draw(st.integers(1, 4))):
+        r = draw(st.sampled_from([5e-4, 1e-3, 5e-3]))
+        direction = np.array(draw(_vector(1.0)))
+        length = float(np.linalg.norm(direction))
+        direction = direction / length if length > 1e-3 else into / np.linalg.norm(into)
+        overlap = draw(st.floats(1e-4, 0.06))
+        p = centre + direction * (big + r - overlap)
+        p = np.clip(p, -(half - r), half - r)
+        radii.append(r)
+        positions.append(tuple(float(c) for c in p))
+    n = len(radii)
+    speed = draw(st.sampled_from([0.0, 1.0, 10.0, 20.0]))
+    elastic = draw(st.booleans())
+    return Turned(
+        **_floor_box(draw, elastic),
+        positions=tuple(positions),
+        velocities=((0.0, 0.0, 0.0),) + tuple(draw(_vector(speed)) for _ in range(n - 1)),
+        radii=tuple(radii),
+        masses=(draw(st.sampled_from([1.0, 100.0])),) + (0.01,) * (n - 1),
+    )
+
+
+@st.composite
+def struck_sleepers(draw) -> Turned:
+    """A row or heap of 2–8 balls asleep on the floor of a turned box, struck by a ball thrown at 2 to
+    1,000 m/s from across the box once they sleep, so that it arrives inside a step."""
+    half = 1.0
+    n = draw(st.integers(2, 8))
+    r = draw(st.sampled_from([0.02, 0.05, 0.1]))
+    heap = draw(st.booleans())
+    positions = []
+    for i in range(n):
+        if heap and i >= 3:  # on top of the first three
+            positions.append((0.0, -half + r + (i - 2) * 2.0 * r * 1.2, 0.0))
+        else:
+            positions.append(((i - n / 2) * 2.0 * r * draw(st.sampled_from([1.0, 1.01])), -half + r, 0.0))
+    target = np.array(positions[draw(st.integers(0, n - 1))])
+    start = np.array(
+        [draw(st.sampled_from([-0.8, 0.8])), draw(st.floats(-0.8, 0.8)), draw(st.floats(-0.8, 0.8))]
+    )
+    speed = draw(st.sampled_from([2.0, 20.0, 200.0, 1000.0]))
+    aim = target - start
+    elastic = draw(st.booleans())
+    return Turned(
+        **_floor_box(draw, elastic),
+        positions=tuple(positions),
+        velocities=((0.0, 0.0, 0.0),) * n,
+        radii=(r,) * n,
+        masses=tuple(draw(st.lists(st.sampled_from([0.1, 1.0, 10.0]), min_size=n, max_size=n))),
+        sleep=True,
+        strike=(
+            draw(st.sampled_from([r, r / 4])),
+            draw(st.sampled_from([0.1, 1.0, 10.0])),
+            tuple(float(c) for c in start),
+            tuple(float(c) for c in aim / np.linalg.norm(aim) * speed),
+        ),
+    )
+
+
+@st.composite
+def mass_chains(draw) -> Turned:
+    """A chain of 2–5 balls against a wall, an edge or a corner of a turned box, along gravity, each
+    ball 2 to 100 times heavier than the one below it (or lighter), the top one maybe thrown in."""
+    half = 1.0
+    n = draw(st.integers(2, 5))
+    radii = draw(st.lists(st.sampled_from([0.001, 0.005, 0.01, 0.05]), min_size=n, max_size=n))
+    into = _into(draw)
+    if draw(st.booleans()):  # a single wall
+        keep = draw(st.sampled_from(np.flatnonzero(into).tolist()))  # one of the walls it pressed
+        into = np.where(np.arange(3) == keep, into, 0.0)
+    positions = _pressed(draw, half, into, radii, heaps=True)
+    ratio = draw(st.sampled_from([2.0, 7.0, 47.0, 100.0, 0.1]))
+    masses = tuple(float(0.01 * ratio**i) for i in range(n))
+    top = draw(st.sampled_from([0.0, 1.0, 10.0]))
+    velocities = [(0.0, 0.0, 0.0)] * (n - 1) + [tuple(float(c) for c in into / np.linalg.norm(into) * top)]
+    elastic = draw(st.booleans())
+    timesteps = (1 / 240, 1 / 60, 0.05)
+    return Turned(
+        **_corner_box(draw, half, into, INTEGRATOR_NAMES, timesteps, elastic),
+        positions=tuple(positions),
+        velocities=tuple(velocities),
+        radii=tuple(radii),
+        masses=masses,
+    )
+
+
+def _energy(world: ballpit.World) -> float:
+    return world.kinetic_energy() + world.potential_energy()
+
+
+def _energy_scale(world: ballpit.World, half: float) -> float:
+    """What rounding in the total energy is measured against: the kinetic energy plus what gravity
+    could give or take across the box."""
+    g = float(np.linalg.norm(world.gravity))
+    return world.kinetic_energy() + float(np.sum(world.spheres.masses)) * g * 2.0 * half + 1e-300
+
+
+def check_turned_box(box: Turned) -> None:
+    """Run ``box``: after every step no state is non-finite, no ball's centre is beyond a wall, and an
+    elastic frictionless box (integrated exactly) gains no energy beyond rounding."""
+    world = box.world()
+    steps = box.steps
+    if box.strike is not None:  # let the others fall asleep (at most 2 s), then throw the striker
+        for _ in range(int(2.0 / box.dt)):
+            world.step(box.dt)
+            if world.asleep.all():
+                break
+        box.throw(world)
+    start, scale = _energy(world), _energy_scale(world, box.half)
+    tolerance = 1e-9 * box.half  # rounding in the turned frame's coordinates
+    for k in range(steps):
+        crowded = world.crowded_steps
+        world.step(box.dt)
+        how = "whole (crowded)" if world.crowded_steps > crowded else "split at impacts"
+        body = world.state.body
+        assert np.isfinite(body).all(), f"step {k + 1}, {how}: a ball's state is not finite"
+        beyond = box.beyond(world)
+        out = np.flatnonzero(~(beyond <= tolerance))
+        assert out.size == 0, (
+            f"step {k + 1}, {how}: balls {out.tolist()} (r = {world.spheres.radii[out].tolist()}) are "
+            f"{beyond[out].tolist()} m beyond a wall"
+        )
+        if box.elastic():
+            gain = _energy(world) - start
+            assert gain <= 1e-9 * scale, f"step {k + 1}, {how}: energy rose by {gain} J (of {scale} J)"
+
+
+@WIDE
+@given(pressed_into_corners(integrators=("euler",), timesteps=(0.05, 0.1, 0.2)))
+def test_no_ball_leaves_a_turned_box_under_explicit_euler_at_large_steps(box):
+    check_turned_box(box)
+
+
+@WIDE
+@given(pressed_into_corners())
+def test_no_ball_pressed_into_an_edge_or_corner_leaves_a_turned_box(box):
+    check_turned_box(box)
+
+
+@WIDE
+@given(fast_in_turned_squares())
+def test_no_ball_at_a_thousand_metres_a_second_leaves_a_turned_box_of_squares(box):
+    check_turned_box(box)
+
+
+@WIDE
+@given(overlapping_starts())
+def test_no_small_ball_starting_inside_a_big_one_is_pushed_out_of_the_box(box):
+    check_turned_box(box)
+
+
+@WIDE
+@given(struck_sleepers())
+def test_no_ball_leaves_the_box_when_a_sleeping_pile_is_struck(box):
+    check_turned_box(box)
+
+
+@WIDE
+@given(mass_chains())
+def test_no_ball_of_a_mass_chain_against_a_wall_leaves_the_box(box):
+    check_turned_box(box)

@@ -151,7 +151,7 @@ def test_directory_and_binary_files(tmp_path):
         (["simulate", "scenes/slopes.toml", "--frobnicate"], "--frobnicate"),
         (["simulate"], "scene"),
         (["render", "scenes/slopes.toml", "--out", "x.gif", "--size", "big"], "--size"),
-        (["render", "scenes/slopes.toml", "--out", "x.mp4"], "x.mp4"),
+        (["render", "scenes/slopes.toml", "--out", "x.avi"], "x.avi"),
         (["nonsense"], "nonsense"),
         (["render", "scenes/slopes.toml"], "--out"),
         (["render", "scenes/slopes.toml", "--out", "x.gif", "--fps", "0"], "--fps"),

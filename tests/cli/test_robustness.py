@@ -141,7 +141,11 @@ def test_ctrl_c_at_any_moment_after_python_started_exits_130_in_one_line():
         stderr = proc.stderr.read().decode()
         proc.wait(timeout=60)
         assert "Traceback" not in stderr, stderr
-        if proc.returncode != 0:  # else the check was done before the signal came
+        if proc.returncode == -signal.SIGINT:
+            # The signal came after main had returned and given Ctrl+C back: Python then ends by the
+            # signal itself, which a shell reports as 130 too, and prints nothing.
+            assert stderr == ""
+        elif proc.returncode != 0:  # else the check was done before the signal came
             assert (proc.returncode, stderr) == (cli.EXIT_INTERRUPTED, "ballpit: interrupted\n")
 
 

@@ -246,3 +246,57 @@ def test_the_galilean_cannon_in_a_crowded_scene_throws_the_small_ball_at_the_clo
         world.step(dt)
     assert world.crowded_steps == before + 1, "the landing was a soft-step frame"
     assert float(top.velocity[1]) == pytest.approx((3 * M - m) / (M + m) * -falling, rel=0.02)
+
+
+def cube(world: ballpit.World, restitution: float = 1.0, friction: float = 0.0) -> None:
+    """Six infinite walls facing in: |x|, |y|, |z| ≤ 1."""
+    for face in (*np.eye(3), *-np.eye(3)):
+        world.add_plane(position=face, normal=-face, restitution=restitution, friction=friction)
+
+
+# Three 1 mm balls pressed into the corner (−1, −1, −1) of the cube by gravity (−9.81, −9.81, −9.81),
+# as a search found them: positions, then velocities.
+CORNER_THREES = [
+    (
+        [
+            [-0.999, -0.9953809, -0.99890502],
+            [-0.999, -0.99510616, -0.99793818],
+            [-0.99896115, -0.999, -0.999],
+        ],
+        [
+            [-1.49285701, -0.07219059, -1.77790539],
+            [0.91877888, 0.93414442, -0.76218333],
+            [-0.36896465, -2.2109122, -0.26794576],
+        ],
+    ),
+    (
+        [[-0.999, -0.999, -0.99863195], [-0.999, -0.99527325, -0.999], [-0.99819836, -0.999, -0.99644872]],
+        [
+            [-0.75541953, 1.05321526, -0.33504815],
+            [-0.66757282, 0.13828256, -1.41552595],
+            [-1.13932772, 0.51032543, -0.30315349],
+        ],
+    ),
+    ([[-0.999, -0.999, -0.999], [-0.997, -0.999, -0.999], [-0.999, -0.997, -0.999]], [[0.0] * 3] * 3),
+]
+
+
+@pytest.mark.parametrize("start", range(len(CORNER_THREES)))
+def test_balls_pressed_into_a_corner_stay_in_the_box_under_explicit_euler_at_large_steps(start):
+    """Three 1 mm balls in a corner of a closed elastic frictionless cube, gravity into the corner,
+    explicit Euler at 0.1 s a step. The stop of the slow approaches (e = 0) left a ball pressed by the
+    others still closing on a wall at a few cm/s (Gauss–Seidel hands the momentum down the column a
+    little at a time), and explicit Euler moves a ball by its velocity at the interval's start, which no
+    resting force changes: a ball went 1 mm beyond a wall at step 3 (23 mm at step 2 in another start)
+    and fell on out of the box. Planes win at the interval's start too: no centre leaves the cube, and
+    no ball sinks into a wall by a tenth of its radius."""
+    positions, velocities = CORNER_THREES[start]
+    world = ballpit.World(gravity=(-G, -G, -G), integrator="euler")
+    cube(world)
+    r = 0.001
+    world.add_spheres(positions, radius=r, velocity=velocities, restitution=1.0, friction=0.0)
+    for _ in range(40):
+        world.step(0.1)
+        reach = np.abs(world.spheres.positions).max(axis=1)
+        assert (reach < 1.0).all()
+        assert (reach - (1.0 - r) < 0.1 * r).all()

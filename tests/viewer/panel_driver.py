@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 from window_driver import grab, open_viewer, point_at, press, pump, settle, xdotool
 from window_driver import main as window_main
 
@@ -292,7 +293,106 @@ def orbit(workdir: Path) -> dict:
     return out
 
 
-SCENARIOS = {f.__name__: f for f in (scene_list, drop_buttons, restitution_edit, file_drop, add_ball, orbit)}
+def energy_legend(workdir: Path) -> dict:
+    """Ghosts on (G), the energy plot open (P), the drop (X): where ImPlot put the plot's legend, and
+    how many of its pixels are in each curve's colour."""
+    from ballpit.viewer.energyplot import KINETIC_COLOR, POTENTIAL_COLOR
+    from ballpit.viewer.ghosts import TINTS
+
+    viewer = panel_viewer(workdir)
+    press(viewer, "G", frames=2)
+    press(viewer, "P", frames=2)
+    press(viewer, "X", frames=40)
+    image = grab(viewer)
+    rects = viewer.panel.rects
+    out: dict = {"frame": rects["frame energy"], "legend": rects["legend energy"]}
+    x, y, w, h = (round(v) for v in rects["legend energy"])
+    region = image[y : y + h, x : x + w]
+    colors = {"kinetic": KINETIC_COLOR, "potential": POTENTIAL_COLOR} | {
+        name: (*rgb, 1.0) for name, rgb in TINTS.items()
+    }
+    out["swatches"] = {
+        name: int((np.abs(region - np.round(np.array(c[:3]) * 255)).max(axis=-1) < 12).sum())
+        for name, c in colors.items()
+    }
+    out["ghosts"] = len(viewer.shown.ghosts or ())
+    return out
+
+
+def _open_record_section(viewer: Viewer) -> None:
+    """Fold the sections above it and open "Record video", so its button is on screen."""
+    collapse(viewer, "Scenes", "Simulation", "Inspector")
+    click(viewer, "section Record video", frames=3)
+    wait_for(viewer, lambda: "Record MP4" in viewer.panel.rects)
+
+
+def record_button(workdir: Path) -> dict:
+    """X, then a click on Record MP4, a second of the run, and a click again: the MP4 it wrote, the
+    panel's state while it recorded and after, and the window's pixels at a state the video holds."""
+    viewer = panel_viewer(workdir)
+    _open_record_section(viewer)
+    press(viewer, "X", frames=3)
+    click(viewer, "Record MP4")
+    video = viewer.video
+    out: dict = {"recording": video.is_recording, "panel_width": viewer.panel.width}
+    pump(viewer, 60)
+    pump(viewer, 1)
+    while video.clock.last != viewer.shown.time:  # the state shown now is one the video holds
+        pump(viewer, 1)
+    image = grab(viewer)
+    out["window"] = str(workdir / "window.png")
+    Image.fromarray(image.astype(np.uint8)).save(out["window"])
+    out["grabbed_frame"] = video.clock.frames - 1  # the index of the frame that state went to
+    out["rec_red"] = red_pixels(image, viewer.panel.rects["recording"])  # "● REC 1.0 s" in the panel
+    out["seconds_shown"] = video.seconds
+    click(viewer, "Record MP4")
+    out["after_second_click"] = video.is_recording
+    finished = video.last_video
+    out["video"] = {"path": str(finished.path), "frames": finished.frames, "seconds": finished.seconds}
+    out["covered"] = video.clock.last - video.started_at  # simulated s from the first frame to the last
+    out["fps"] = video.fps
+    pump(viewer, 2)
+    out["saved_line"] = "video saved" in viewer.panel.rects
+    out["still_runs"] = viewer.sim.phase.name
+    return out
+
+
+def record_without_pyav(workdir: Path) -> dict:
+    """PyAV cannot be imported (a minimal install): Record MP4 shows why in the panel, in red, on its
+    own, and the run goes on."""
+    import sys
+
+    sys.modules["av"] = None  # type: ignore[assignment]  # import av now raises ImportError
+    viewer = panel_viewer(workdir)
+    _open_record_section(viewer)
+    press(viewer, "X", frames=3)
+    click(viewer, "Record MP4")
+    pump(viewer, 2)
+    t = viewer.sim.world.time
+    pump(viewer, 30)
+    image = grab(viewer)
+    out: dict = {"recording": viewer.video.is_recording, "error": viewer.video.error}
+    out["error_red"] = red_pixels(image, viewer.panel.rects["error video"])
+    out["error_height"] = viewer.panel.rects["error video"][3]
+    out["ran_on"] = viewer.sim.world.time - t
+    out["videos"] = (workdir / "videos").exists()
+    return out
+
+
+SCENARIOS = {
+    f.__name__: f
+    for f in (
+        scene_list,
+        drop_buttons,
+        restitution_edit,
+        file_drop,
+        add_ball,
+        orbit,
+        energy_legend,
+        record_button,
+        record_without_pyav,
+    )
+}
 
 
 if __name__ == "__main__":

@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.physics.contacts import KIND_NAMES
 from ballpit.scene import read_scene
 from ballpit.viewer.camera import Camera
 from ballpit.viewer.interaction import SHOT_SPEEDS, TILT_RATE, Interaction, typical_material
+from ballpit.viewer.picking import pointer_ray
 from ballpit.viewer.simulation import Phase, Simulation
 
 from .conftest import REPO, line_of_balls
@@ -82,6 +84,25 @@ def test_a_selected_plane_turns_only_while_a_key_is_held_and_gets_its_own_motion
     assert np.allclose(world.planes[1].angular_velocity, [0.0, 0.1, 0.0])
     assert not hands.takes_key("RIGHT")  # → steps again
     assert sim.phase is Phase.WAITING
+
+
+def test_a_clicked_plane_is_named_by_the_index_the_events_give_it():
+    """The HUD numbers planes as world.planes and the events' b (plane index) do: from 0."""
+    world = line_of_balls(1, y=3.0)  # plane 0 the ground, plane 1 a slope under the ball
+    sim = Simulation(world)
+    contacts = []
+    while not contacts:
+        record = world.step(sim.timestep)
+        contacts = [int(b) for k, b in zip(record.kind, record.b, strict=True) if k == 0]
+    assert KIND_NAMES[0] == "sphere-plane" and contacts == [1]  # the ball landed on plane index 1
+    hands = Interaction(sim)
+    camera = Camera.looking_at((0, 3, 10), (0, 2, 0))
+    (x, y), _ = camera.project(np.asarray(world.planes[1].position), 320, 180)  # rows from the top
+    ray = pointer_ray(camera, x, 180 - y, 320, 180)  # pyglet's y runs up
+    message = hands.press(ray, x, 180 - y, camera.forward)
+    assert hands.selected_plane == 1
+    assert message.startswith("plane 1 selected")
+    assert hands.hud_lines() == ["selected    plane 1: arrows PgUp PgDn"]
 
 
 def test_a_ball_pulled_by_the_mouse_joint_into_another_ball_pushes_it_and_never_passes_through_it():

@@ -3,6 +3,7 @@ typing, a file dropped on the window; pictures read back where a picture is what
 
 from __future__ import annotations
 
+import math
 import shutil
 from pathlib import Path
 
@@ -12,12 +13,21 @@ import pytest
 from .conftest import run_driver
 
 DRIVER = Path(__file__).with_name("panel_driver.py")
-BATCH = ("scene_list", "drop_buttons", "restitution_edit", "file_drop", "add_ball", "orbit")
+BATCH = (
+    "scene_list",
+    "drop_buttons",
+    "restitution_edit",
+    "file_drop",
+    "add_ball",
+    "orbit",
+    "energy_legend",
+    "record_button",
+)
 pytestmark = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    return run_driver(DRIVER, display, name, workdir, timeout=240, batch=BATCH)
+    return run_driver(DRIVER, display, name, workdir, timeout=240, batch=BATCH if name in BATCH else ())
 
 
 def test_clicking_a_scene_in_the_list_loads_it_and_f4_hides_the_panel(xvfb, tmp_path):
@@ -101,3 +111,51 @@ def test_a_double_clicked_ball_is_orbited_the_wheel_zooms_a_drag_turns_and_home_
     assert r["looks_at_target"] < 1e-9  # ...still looking at it
     active, eye, filed = r["after_home"]
     assert not active and np.allclose(eye, filed)  # the scene's view (it has a ground), flying free
+
+
+def test_the_energy_plots_legend_with_ghosts_stays_inside_the_plot_and_shows_every_curves_colour(
+    xvfb, tmp_path
+):
+    r = run_scenario(xvfb, "energy_legend", tmp_path)
+    assert r["ghosts"] == 3  # K, U and four totals: the widest the legend gets
+    fx, fy, fw, fh = r["frame"]
+    lx, ly, lw, lh = r["legend"]
+    assert fx <= lx and lx + lw <= fx + fw and fy <= ly and ly + lh <= fy + fh  # not clipped
+    for name, pixels in r["swatches"].items():  # each curve's swatch drawn in the legend, in its colour
+        assert pixels >= 50, (name, r["swatches"])
+
+
+def test_the_record_button_records_the_3d_view_at_simulated_time_and_a_second_click_writes_the_mp4(
+    xvfb, tmp_path
+):
+    from PIL import Image
+
+    from .test_mp4 import decode
+
+    r = run_scenario(xvfb, "record_button", tmp_path)
+    assert r["recording"] and not r["after_second_click"] and r["still_runs"] == "RUNNING"
+    assert r["rec_red"] > 30 and r["saved_line"]  # "REC 1.1 s" in red while it recorded; then the file
+    video = r["video"]
+    # one frame per 1/30 s of the simulated time covered (its first and last state included): about
+    # 1.1 s of 1/60 s frames between the clicks
+    assert 1.0 <= r["covered"] <= 1.5
+    assert video["frames"] == math.floor(r["covered"] * r["fps"] + 1e-6) + 1
+    frames, facts = decode(video["path"])
+    assert facts["frames"] == len(frames) == video["frames"]
+    assert facts["seconds"] == pytest.approx(video["frames"] / 30, abs=1e-3) and facts["rate"] == 30
+    # the 3-D view right of the panel (with the HUD and the bar), not the panel
+    w = r["panel_width"]
+    assert facts["size"] == (1280 - w, 720)
+    window = np.asarray(Image.open(r["window"]), dtype=int)
+    frame = frames[r["grabbed_frame"]].astype(int)
+    below_mark = slice(40, None)  # the window's red "REC" mark, top right, is not in the video
+    assert np.abs(frame - window[:, w:])[below_mark].mean() < 5
+    assert np.abs(frame - window[:, : 1280 - w])[below_mark].mean() > 15
+
+
+def test_without_pyav_the_record_button_says_why_in_the_panel_and_the_run_goes_on(xvfb, tmp_path):
+    r = run_scenario(xvfb, "record_without_pyav", tmp_path)
+    assert not r["recording"] and not r["videos"]
+    assert r["error"] == "recording video needs PyAV, which is not installed: pip install 'ballpit[video]'"
+    assert r["error_red"] > 50  # in the panel, in red
+    assert r["ran_on"] == pytest.approx(30 / 60, abs=1e-6)  # 30 frames of 1/60 s after the click

@@ -9,7 +9,15 @@ import pytest
 
 import ballpit
 from ballpit.viewer.camera import Camera
-from ballpit.viewer.picking import Ray, pick, pointer_ray, ray_plane_point, ray_planes, ray_spheres
+from ballpit.viewer.picking import (
+    INFINITE_PICK_DISTANCE,
+    Ray,
+    pick,
+    pointer_ray,
+    ray_plane_point,
+    ray_planes,
+    ray_spheres,
+)
 
 
 def _ray(origin, direction) -> Ray:
@@ -84,3 +92,26 @@ def test_the_drag_plane_meets_the_ray_where_the_line_crosses_it():
     point = ray_plane_point(_ray((0, 0, 0), (1, 1, 0)), np.array([2.0, 0.0, 0.0]), np.array([1.0, 0, 0]))
     assert np.allclose(point, [2, 2, 0])
     assert ray_plane_point(_ray((0, 0, 0), (0, 1, 0)), np.array([2.0, 0, 0]), np.array([1.0, 0, 0])) is None
+
+
+def test_the_ground_is_picked_only_where_the_fog_still_shows_it():
+    """A click just above where the ground fades into the sky hits it hundreds of metres away: that
+    selects nothing. Nearer than INFINITE_PICK_DISTANCE it is picked; a finite plane at any distance."""
+    from ballpit.viewer.renderer import FOG_DENSITY  # the fog's constant (the module imports OpenGL)
+
+    assert math.exp(-((FOG_DENSITY * INFINITE_PICK_DISTANCE) ** 2)) == pytest.approx(0.1, abs=0.01)
+    world = ballpit.World()
+    world.add_plane(position=(0, 0, 0))
+    eye = np.array([0.0, 4.0, 0.0])
+
+    def towards(distance: float) -> Ray:  # a ray meeting the ground ``distance`` m away along it
+        down = 4.0 / distance
+        return _ray(eye, (0.0, -down, -math.sqrt(1.0 - down * down)))
+
+    assert pick(towards(300.0), world) is None  # just above the visible horizon: the faded ground
+    near = pick(towards(40.0), world)
+    assert near is not None and near.kind == "plane" and near.distance == pytest.approx(40.0)
+    far_slope = ballpit.World()
+    far_slope.add_plane(position=(0, 0, -300.0), size=40.0)
+    hit = pick(towards(300.0), far_slope)
+    assert hit is not None and hit.index == 0

@@ -78,7 +78,7 @@ def test_render_to_a_png_file_writes_the_last_frame(offscreen, tmp_path):
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"out": "movie.mp4"}, "out must be"),
+        ({"out": "movie.avi"}, "out must be"),
         ({"duration": 0}, "duration"),
         ({"fps": -1}, "fps"),
         ({"size": (8, 8)}, "size"),

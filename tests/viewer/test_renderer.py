@@ -208,7 +208,7 @@ def test_overlays_draw_contacts_velocity_arrows_and_trails(offscreen):
     flags = OverlayFlags(contacts=True, velocities=True, trails=True)
     shown = offscreen.render(sim, camera, flags).astype(int)
     labels = [c.label for c in offscreen.renderer.draws.calls]
-    assert labels == ["planes", "balls", "world lines", "overlay lines"]
+    assert labels == ["planes", "balls", "trails", "overlay lines"]
     changed = np.abs(shown - plain).max(axis=-1) > 40
     assert changed.sum() > 20
     # the contact cross (yellow) sits at the contact point under the ball
@@ -303,3 +303,59 @@ def test_balls_touching_the_back_of_an_opaque_wall_never_show_through_it(offscre
         balls = screen.render(scene(True), camera).astype(int)
     leaks = int((np.abs(balls - wall).max(axis=-1) > 2).sum())
     assert leaks == 0
+
+
+def test_a_slope_tilted_over_keeps_its_colour_on_its_back(offscreen):
+    """A slope (a finite plane facing up as the scene starts) is solid: tilted until its back faces the
+    camera it is drawn opaque in its own colour, lit as a face of its own, not as a faint wall."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    world.add_plane(position=(0, 1.5, 0), rotation=(0, 0, 10), size=2.0, restitution=1.0)  # orange
+    sim = Simulation(world)
+    camera = Camera.looking_at((0.0, 4.0, -6.0), (0.0, 1.5, 0.0))
+    front = offscreen.render(sim, camera).astype(int)
+    (cx, cy), _ = camera.project(np.array([0.0, 1.5, 0.0]), 200, 150)
+    center = (int(cy), int(cx))
+    assert front[center][0] > front[center][2] + 60  # orange, from the front
+    slope = world.planes[1]
+    slope.angular_velocity = (math.radians(120), 0.0, 0.0)  # tipped over towards +z, away from the camera
+    for _ in range(240):
+        world.step(1 / 240)
+    slope.angular_velocity = (0.0, 0.0, 0.0)
+    eye = np.asarray(camera.position, float)
+    assert np.dot(eye - slope.position, slope.normal) < 0  # the camera sees its back now
+    back = offscreen.render(sim, camera).astype(int)
+    assert "solid plane backs" in [c.label for c in offscreen.renderer.draws.calls]
+    pixel = back[center]
+    assert np.abs(pixel - background_pixel()).max() > 40  # not a faint tint over the background
+    assert pixel[0] > pixel[2] + 30 and pixel[0] > pixel[1]  # still orange (in the shade: darker)
+
+
+def test_trails_are_ribbons_several_pixels_wide_in_the_balls_colour_fading_with_age(offscreen):
+    """T draws each ball's recent path as a band facing the eye, not a 1-pixel line: here a ball of
+    0.3 m passing 3 m from the camera leaves a trail about 8 pixels wide next to it."""
+    from ballpit.viewer.frame import OverlayFlags
+
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_sphere(position=(-1.5, 1.0, 0.0), radius=0.3, velocity=(2.0, 0.0, 0.0))
+    sim = Simulation(world)
+    sim.appearance.sphere_colors = np.array([RED])
+    sim.start()
+    for _ in range(60):  # 1 s: from x = -1.5 to 0.5
+        sim.advance(1 / 60)
+    camera = Camera.looking_at((0.0, 1.0, 3.0), (-0.3, 1.0, 0.0))
+    plain = offscreen.render(sim, camera).astype(int)
+    traced = offscreen.render(sim, camera, OverlayFlags(trails=True)).astype(int)
+    assert "trails" in [c.label for c in offscreen.renderer.draws.calls]
+    trail = np.abs(traced - plain).max(axis=-1) > 20
+    widths = {}
+    for x in (-0.5, -1.0):  # just behind the ball, and half a second back
+        (px, _), _ = camera.project(np.array([x, 1.0, 0.0]), 200, 150)
+        column = trail[:, int(px)]
+        widths[x] = int(column.sum())
+        assert np.all(traced[column, int(px), 0] > traced[column, int(px), 2] + 20)  # red, as the ball
+    assert widths[-0.5] >= 5 and widths[-1.0] >= 3
+    # it fades with age: newer parts are more opaque (redder over the dark background)
+    (new_x, new_y), _ = camera.project(np.array([-0.5, 1.0, 0.0]), 200, 150)
+    (old_x, old_y), _ = camera.project(np.array([-1.3, 1.0, 0.0]), 200, 150)
+    assert traced[int(new_y), int(new_x), 0] > traced[int(old_y), int(old_x), 0] + 15

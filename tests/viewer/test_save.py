@@ -276,6 +276,25 @@ def test_a_world_built_in_code_says_so_when_saved():
     assert text.startswith(SAVED_MARK + "a world built in code") and "original's" not in text
 
 
+def test_a_bundled_scene_is_saved_in_the_current_directory_not_inside_the_package(tmp_path, monkeypatch):
+    from ballpit.scene import bundled_scenes_dir, default_scene_path
+
+    monkeypatch.chdir(tmp_path)
+    before = sorted(p.name for p in bundled_scenes_dir().iterdir())
+    sim = Simulation(read_scene(default_scene_path()))
+    camera = Camera.looking_at(sim.appearance.camera_position, sim.appearance.camera_look_at)
+    saved = save_scene(sim, camera)
+    assert saved == tmp_path / "slopes-saved-1.toml"
+    assert sorted(p.name for p in bundled_scenes_dir().iterdir()) == before  # nothing added there
+    assert read_scene(saved).world.planes[1].restitution == 0.8  # the demo's first slope, loaded back
+    # a scene file of the user's own is saved beside it, wherever the current directory is
+    own = tmp_path / "mine" / "drop.toml"
+    own.parent.mkdir()
+    own.write_text(SCENE)
+    sim = Simulation(read_scene(own), own)
+    assert save_scene(sim, camera) == own.parent / "drop-saved-1.toml"
+
+
 def test_a_scene_starting_with_a_byte_order_mark_saves_with_its_comments(tmp_path):
     path = tmp_path / "notepad.toml"
     path.write_bytes(codecs.BOM_UTF8 + SCENE.encode())

@@ -6,7 +6,16 @@ import pytest
 
 from ballpit.viewer.shaders import ShaderError, load_source, shader_dir
 
-BUNDLED = ("ball.vert", "ball.frag", "plane.vert", "plane.frag", "line.vert", "line.frag", "common.glsl")
+BUNDLED = (
+    "ball.vert",
+    "ball.frag",
+    "plane.vert",
+    "plane.frag",
+    "line.vert",
+    "line.frag",
+    "common.glsl",
+    "casters.glsl",
+)
 
 
 def test_the_bundled_shaders_ship_in_the_shader_directory():

@@ -140,6 +140,92 @@ def test_shadows_fall_on_slopes_too_and_can_be_turned_off(offscreen):
     assert (without - with_shadows)[pixel(slope_point)] > 100
 
 
+SLOPE = {"position": (-0.5, 1.0, -0.5), "rotation": (0, 0, 10), "size": 2.0}
+
+
+def slope_scene(ball: bool) -> Simulation:
+    """The floor, a 2 m square slope 1 m above it, and (``ball``) a ball 0.8 m above the slope."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    world.add_plane(**SLOPE)
+    if ball:
+        world.add_sphere(position=(-0.5, 1.9, -0.5), radius=0.25)
+    return Simulation(world)
+
+
+def slope_frame() -> tuple[np.ndarray, ...]:
+    """The slope's centre, normal and in-plane axes."""
+    slope = slope_scene(ball=False).world.planes[1]
+    return (np.array(slope.position), np.array(slope.normal), *map(np.array, slope.axes))
+
+
+SLOPE_FRAME = slope_frame()
+
+
+def crosses_slope(start: np.ndarray, direction: np.ndarray, margin: float) -> bool:
+    """Whether the half-line from ``start`` along ``direction`` crosses the slope at least ``margin``
+    inside its edges (negative: or that close outside them)."""
+    center, normal, u, v = SLOPE_FRAME
+    t = np.dot(center - start, normal) / np.dot(direction, normal)
+    if t <= 0:
+        return False
+    local = start + t * direction - center
+    return max(abs(np.dot(local, u)), abs(np.dot(local, v))) <= 1.0 - margin
+
+
+def floor_points(in_shadow: bool) -> list[np.ndarray]:
+    """Floor points seen past the slope (not hidden by it), in its shadow or clear of it, by a
+    20 cm margin: along the light each one's ray crosses the slope well inside it, or misses it."""
+    found = []
+    for x in np.linspace(-3, 3, 25):
+        for z in np.linspace(-3, 3, 25):
+            p = np.array([x, 0.0, z])
+            row, col = pixel(p)
+            if not (2 <= row < 148 and 2 <= col < 198):
+                continue
+            eye = np.asarray(CAMERA.position, float)
+            if crosses_slope(eye, (p - eye) / np.linalg.norm(p - eye), -0.2):
+                continue  # the slope is in front of it
+            if crosses_slope(p, SUN, 0.2 if in_shadow else -0.2) == in_shadow:
+                found.append(p)
+    return found
+
+
+def test_a_slope_shades_the_floor_under_it_along_the_light(offscreen):
+    sim = slope_scene(ball=False)
+    lit = brightness(offscreen.render(sim, CAMERA))
+    shaded, clear = floor_points(in_shadow=True), floor_points(in_shadow=False)
+    assert len(shaded) >= 5 and len(clear) >= 100
+    # the floor's cells and grid lines differ by up to a third; the sun's share of the light is more
+    typical_clear = np.median([lit[pixel(p)] for p in clear])
+    assert all(typical_clear - lit[pixel(p)] > 150 for p in shaded)
+    offscreen.renderer.shadows = False  # shadows off: no slope shadow either
+    try:
+        unshaded = brightness(offscreen.render(sim, CAMERA))
+    finally:
+        offscreen.renderer.shadows = True
+    assert all(unshaded[pixel(p)] - lit[pixel(p)] > 100 for p in shaded)
+
+
+def test_a_ball_above_a_slope_shades_the_slope_and_casts_no_second_shadow_through_it(offscreen):
+    no_ball = brightness(offscreen.render(slope_scene(ball=False), CAMERA))
+    ball = brightness(offscreen.render(slope_scene(ball=True), CAMERA))
+    center = np.array([-0.5, 1.9, -0.5])
+    covered = sphere_mask(CAMERA, center, 0.25 * 1.08)
+    on_floor = shadow_center(center)  # where its shadow would fall if the slope let light through
+    assert crosses_slope(on_floor, SUN, 0.3)
+    eye = np.asarray(CAMERA.position, float)
+    assert not crosses_slope(eye, (on_floor - eye) / np.linalg.norm(on_floor - eye), -0.1)  # seen
+    assert not covered[pixel(on_floor)]
+    assert abs(ball[pixel(on_floor)] - no_ball[pixel(on_floor)]) <= 6  # the slope's shade, nothing more
+    # where the ray from the ball's centre away from the sun meets the slope: its shadow is there
+    slope = slope_scene(ball=False).world.planes[1]
+    t = np.dot(slope.position - center, slope.normal) / np.dot(-SUN, slope.normal)
+    on_slope = center - t * SUN
+    assert not covered[pixel(on_slope)]
+    assert no_ball[pixel(on_slope)] - ball[pixel(on_slope)] > 100
+
+
 # ---------------------------------------------------------------- the grid itself (no GL)
 
 
@@ -186,3 +272,28 @@ def test_the_sun_grid_stays_bounded():
     assert grid.ranges.shape == (grid.cells, 2) and grid.ranges[-1, 1] == len(grid.balls)
     assert np.all(np.diff(grid.ranges, axis=1) <= shadows.LIMIT)
     assert np.all(grid.ranges[1:, 0] == grid.ranges[:-1, 1])
+
+
+def test_a_ball_under_a_slope_is_in_its_shade(offscreen):
+    def scene(slope: bool) -> Simulation:
+        world = ballpit.World(gravity=(0, 0, 0))
+        world.add_plane(position=(0, 0, 0))
+        if slope:
+            world.add_plane(position=(0, 1.5, 0), size=3.0)  # its shadow covers the ball (below)
+        world.add_sphere(position=(0.0, 0.3, 0.0), radius=0.3)
+        return Simulation(world)
+
+    camera = Camera.looking_at((0.0, 0.6, 4.0), (0.0, 0.3, 0.0))  # under the slope's level
+    assert crosses_slope_at((0.0, 0.3, 0.0), height=1.5, half=1.5)
+    ball = sphere_mask(camera, (0.0, 0.3, 0.0), 0.3 * 0.9)  # inside the rim
+    lit = brightness(offscreen.render(scene(False), camera))[ball].mean()
+    shaded = brightness(offscreen.render(scene(True), camera))[ball].mean()
+    assert shaded < 0.75 * lit
+
+
+def crosses_slope_at(point, height: float, half: float) -> bool:
+    """Whether the ray from ``point`` towards the sun crosses the level square of half size ``half``
+    centred above the origin at ``height``."""
+    point = np.asarray(point, float)
+    hit = point + SUN * (height - point[1]) / SUN[1]
+    return bool(abs(hit[0]) < half and abs(hit[2]) < half)

@@ -278,9 +278,12 @@ def keys(workdir: Path) -> dict:
     press(viewer, "TAB")
     out["captured"] = viewer.mouse_captured
     press(viewer, "ESCAPE")
-    out["after_first_escape"] = {"captured": viewer.mouse_captured, "closed": viewer.closed}
+    out["after_first_escape"] = {"captured": viewer.mouse_captured, "closed": viewer.closed,
+                                 "message": shown_message(viewer)}  # fmt: skip
+    press(viewer, "ESCAPE")  # the Esc that released the mouse did not arm the quit: this one asks
+    out["after_second_escape"] = {"closed": viewer.closed, "message": shown_message(viewer)}
     press(viewer, "ESCAPE")
-    out["after_second_escape"] = {"closed": viewer.closed}
+    out["after_third_escape"] = {"closed": viewer.closed}
     return out
 
 
@@ -347,15 +350,18 @@ def panel_rectangle(viewer: Viewer, panel: object) -> list[float]:
 
 
 def help_beside_hud(workdir: Path) -> dict:
-    """F1 in windows of several sizes, with the HUD shown: where the two panels are drawn."""
+    """F1 in windows of several sizes, with the HUD shown, and two with the ImGui panel shown too:
+    where the HUD's and the help's panels are drawn."""
     out: dict = {}
-    for size in ((1280, 720), (900, 700), (700, 420)):
-        viewer = open_viewer(size=size, world=balls_world())
+    sizes = [(size, False) for size in ((1280, 720), (900, 700), (700, 420), (600, 300))]
+    for size, shown in [*sizes, ((1280, 720), True), ((800, 450), True)]:
+        viewer = open_viewer(size=size, world=balls_world(), panel=shown)
         pump(viewer, 2)
         press(viewer, "F1", frames=2)
         hud = viewer.hud
-        out[f"{size[0]}x{size[1]}"] = {
+        out[f"{size[0]}x{size[1]}" + (" panel" if shown else "")] = {
             "size": [viewer.window.width, viewer.window.height],
+            "left": viewer.panel.width,
             "help_shown": hud.show_help,
             "hud_drawn": hud.show_hud and not getattr(hud, "help_hides_hud", False),
             "hud": panel_rectangle(viewer, hud.panel),
@@ -366,7 +372,7 @@ def help_beside_hud(workdir: Path) -> dict:
                 hud.help_label.x + hud.help_label.content_width / 2,
                 viewer.window.height - hud.help_label.y + hud.help_label.content_height / 2,
             ],
-            "pixels": screenshot(viewer).tolist() if size == (1280, 720) else None,
+            "pixels": screenshot(viewer).tolist() if size == (1280, 720) and not shown else None,
         }
         viewer.close()
         viewer.pump()

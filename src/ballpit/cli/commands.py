@@ -119,10 +119,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(handler=_compare)
 
-    p = sub.add_parser("render", help="render a scene offscreen to a GIF or a folder of PNG frames")
+    p = sub.add_parser("render", help="render a scene offscreen to an MP4, a GIF or a folder of PNG frames")
     p.add_argument("scene", help="a scene file, or a bundled scene's name")
     p.add_argument(
-        "--out", required=True, metavar="PATH", help="demo.gif, frame.png, or a folder for PNG frames"
+        "--out",
+        required=True,
+        metavar="PATH",
+        help="demo.mp4 (needs the video extra), demo.gif, frame.png, or a folder for PNG frames",
     )
     p.add_argument("--duration", type=_positive, metavar="S", help="seconds to render (default: the scene's "
                    "[world] duration, else 10)")  # fmt: skip
@@ -335,11 +338,13 @@ def _render(args: argparse.Namespace) -> int:
     out = Path(args.out)
     check_name_lengths(out, "--out")
     folder = args.out.endswith(("/", os.sep)) or out.is_dir() or not out.suffix
-    if not folder and out.suffix.lower() not in (".gif", ".png"):
+    if not folder and out.suffix.lower() not in (".gif", ".png", ".mp4"):
         raise OutputError(
-            f"{args.out}: --out must be a .gif, a .png or a folder for frames, not {out.suffix!r}"
+            f"{args.out}: --out must be a .mp4, a .gif, a .png or a folder for frames, not {out.suffix!r}"
         )
     check_output_place(out, "--out", folder)
+    if not folder and out.suffix.lower() == ".mp4":
+        _check_video(args.out, args.size)
     try:
         from ..viewer.render import frame_count, render
     except ImportError as e:
@@ -363,6 +368,20 @@ def _render(args: argparse.Namespace) -> int:
         raise
     print(f"wrote {written or out}")
     return EXIT_OK
+
+
+def _check_video(raw: str, size: tuple[int, int]) -> None:
+    """OutputError or UsageError unless an MP4 of ``size`` can be written: PyAV installed and the size
+    even each way (H.264's 4:2:0 colour)."""
+    from ..viewer.mp4 import MISSING_AV, have_av
+    from .writers import OutputError
+
+    if not have_av():
+        raise OutputError(f"{raw}: --out .mp4 {MISSING_AV}")
+    if size[0] % 2 or size[1] % 2:
+        raise UsageError(
+            f"render --size {size[0]}x{size[1]}: an MP4's width and height must be even (4:2:0 colour)"
+        )
 
 
 def _check_writable(folder: Path, raw: str) -> None:

@@ -177,6 +177,47 @@ def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     return candidate
 
 
+def stick(
+    slip: np.ndarray,
+    spin: np.ndarray,
+    n: np.ndarray,
+    inv_mass_a: np.ndarray,
+    inv_mass_b: np.ndarray,
+    inv_inertia_a: np.ndarray,
+    inv_inertia_b: np.ndarray,
+    arm_a: np.ndarray,
+    arm_b: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The friction impulse P and rolling impulse R that together stop a contact's ``slip`` (its
+    tangential contact-point velocity) and relative ``spin``: the two solved as one block, before the
+    friction cone and the rolling limit are applied.
+
+    Solved one after the other, each undoes part of the other: friction turns the ball, rolling
+    resistance stops the turn, which leaves slip again, and a lone ball coming to rest keeps 5/7 of its
+    slip a sweep (its velocity never reaches zero). From the changes an impulse makes (the module's
+    formulas), with c = ρ_a/I_a − ρ_b/I_b and 1/m_r = 1/I_a + 1/I_b:
+
+        Δslip = P/m_t + c·(n × R),    Δspin = −c·(n × P) + R/m_r.
+
+    Setting them to −slip and −spin: R = m_r·(c·(n × P) − spin), and P·D = c·m_r·(n × spin) − slip with
+    D = 1/m_t − c²·m_r = 1/m_a + 1/m_b + (ρ_a + ρ_b)²/(I_a·I_b·(1/I_a + 1/I_b)), which is at least
+    1/m_a + 1/m_b (written so: against a plane, D is 1/m_a exactly).
+    """
+    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, 1e-300)
+    c = arm_a * inv_inertia_a - arm_b * inv_inertia_b
+    reach = arm_a + arm_b
+    d = (inv_mass_a + inv_mass_b) + inv_inertia_a * inv_inertia_b * reach * reach / inv_r
+    p = exact.cross_cols(n, spin)
+    p *= c / inv_r
+    p -= slip
+    p /= d
+    r = exact.cross_cols(n, p)
+    r *= c
+    r -= spin
+    r /= inv_r
+    return p, r
+
+
 def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """How an overlap moving apart by positions is shared: a moves along n by its part of the overlap
     and b by its (negative) part, each in proportion to its inverse mass (split, in jacobi.py), so the

@@ -37,7 +37,7 @@ import dataclasses
 
 import numpy as np
 
-from . import contact_model, energy_guard, jacobi, solver
+from . import contact_model, energy_guard, jacobi, resting, solver
 from .contact_model import Impulses
 from .contacts import ContactPoints, EventLog
 from .model import Model
@@ -120,12 +120,19 @@ def stop_approaches(
     now: float,
     *,
     jacobi_from: int = JACOBI_FROM,
+    interval: float | None = None,
 ) -> None:
     """Stop every contact still closing faster than its ``min_normal_speed`` allows (e = 0), solved over
     the island of touching contacts around it (BOUNCE_HOPS balls); velocities change in place.
 
     After ``in_waves`` these are the approaches slower than the restitution threshold, and whatever
     still arrives after MAX_WAVES waves. Inelastic impacts never add energy (checked as for a wave).
+
+    The sweeps may leave a ball pressed between heavier ones and a plane still closing on the plane
+    (Gauss–Seidel hands momentum through a light ball at about m_light/m_heavy a sweep). Those speeds
+    start the ``interval`` that follows, and explicit Euler moves a ball by its start velocity alone, so
+    no force over the interval can keep the ball out of the plane: planes win here too
+    (``resting.hold_by_planes``, over the interval's length).
     """
     if len(c) == 0:
         return
@@ -147,6 +154,17 @@ def stop_approaches(
         jacobi_sweeps=BOUNCE_JACOBI_SWEEPS,
         jacobi_from=jacobi_from,
     )
+    if interval is not None:
+        resting.hold_by_planes(
+            island,
+            c.gap[near],
+            model.spheres.radius,
+            v.copy(),
+            v,
+            min_normal_speed[near],
+            imp.normal,
+            interval,
+        )
     scale = energy_guard.keep_impulses(model, island, before, v, w)
     state.body[:, V] = v[:-1]
     state.body[:, W] = w[:-1]

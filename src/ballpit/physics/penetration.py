@@ -20,12 +20,13 @@ from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, PENETRATION_SW
 from .state import State, X, with_static
 
 
-def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> None:
-    """Move overlapping balls apart along the contact normals (positions only), never through a plane."""
+def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> bool:
+    """Move overlapping balls apart along the contact normals (positions only), never through a plane;
+    whether any ball moved."""
     radius = model.spheres.radius
     tolerance = min(PENETRATION_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
     if not np.any(c.gap < -tolerance):
-        return
+        return False
     x = state.body[:, X]
     pos = with_static(x)
     if len(c) >= JACOBI_FROM:  # all contacts at once per sweep, with mass splitting
@@ -35,7 +36,9 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         _separate_by_colour(c, rows, pos)
     new = keep_sides_of_planes(model, state, x, pos[:-1], deeper=True)
     energy_guard.pay_for_lift(model, state, x, new, partly=True)
+    moved = bool((new != x).any())
     x[:] = new
+    return moved
 
 
 def separate(

@@ -18,7 +18,15 @@ from .contacts import ContactPoints, EventLog
 from .forces import ConstantPerBall
 from .model import Model
 from .rows import ContactRows, rows_at_end
-from .settings import HOLD_PASSES, HOLD_SINK, JACOBI_FROM, NEW_DIRECTION, WARM_START_SPAN
+from .settings import (
+    HELD_ALONG,
+    HOLD_LAYERS,
+    HOLD_PASSES,
+    HOLD_SINK,
+    JACOBI_FROM,
+    NEW_DIRECTION,
+    WARM_START_SPAN,
+)
 from .state import State, V, W, shallow_copy, with_static
 
 
@@ -185,7 +193,15 @@ def resting_forces(
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
     hold_by_planes(
-        rows, c.gap, model.spheres.radius, with_static(state.body[:, V]), v, min_normal_speed, imp.normal, h
+        rows,
+        c.gap,
+        model.spheres.radius,
+        with_static(state.body[:, V]),
+        v,
+        min_normal_speed,
+        imp.normal,
+        h,
+        model.integrator.bend,
     )
     if h >= WARM_START_SPAN * dt:
         warm.keep(keys, imp, h)
@@ -202,36 +218,45 @@ def hold_by_planes(
     target: np.ndarray,
     normal: np.ndarray,
     h: float,
+    bend: float = 1.0,
 ) -> None:
     """Planes win: no ball the solve left sinking into a plane it touches by more than HOLD_SINK of its
-    radius over the interval is let sink at all. ``v_start`` and ``v`` (N+1, 3) are the velocities at
-    the interval's start and end (the end changes in place), ``normal`` the accumulated normal impulses
-    (changed in place), ``target`` each contact's least normal speed at the end.
+    radius over the interval is let sink at all, nor is a chain of balls pressing it. ``v_start`` and
+    ``v`` (N+1, 3) are the velocities at the interval's start and end (the end changes in place),
+    ``normal`` the accumulated normal impulses (changed in place), ``target`` each contact's least
+    normal speed at the end, ``bend`` the integrator's (integrators.Integrator.bend).
 
-    Under a constant force a ball moves h·(v_n0 + v_n1)/2 along a normal over the interval. Gauss–Seidel
-    hands momentum through a light ball pressed between a heavy ball and a wall at about
-    m_light/m_heavy a sweep, so at a mass ratio of 47 its sweeps left the light ball sinking a quarter of
-    its radius a step, and the heavy ball pushed it through the wall. Such a ball is held:
+    Under a constant force a ball moves h·((1 − b/2)·v_n0 + (b/2)·v_n1) along a normal over the
+    interval on a path of bend b: the mean of the two speeds for RK2 and RK4, the start speed for
+    explicit Euler, the end speed for symplectic Euler. Gauss–Seidel hands momentum through a light ball
+    pressed between a heavy ball and a wall at about m_light/m_heavy a sweep, so at a mass ratio of 47
+    its sweeps left the light ball sinking a quarter of its radius a step, and the heavy ball pushed it
+    through the wall. Such a ball is held:
 
     1. its plane contacts (and those on sleeping balls: every contact whose far side has no inverse
        mass) are driven to their target, the ball alone moving (impulses only added: a hold pushes);
-    2. a ball pressing a held ball meets it as a ball that can move only along its planes: the held
-       ball's inverse mass along the contact normal n is |P·n|²/m, P the projection off the normals of
-       the planes now pushing it (Gram–Schmidt, elementwise). The impulse J = (target − v_n)/(1/m_a' +
-       1/m_b') stops the approach and moves the held ball by J·P·n/m, along its planes only: the
-       active-set answer the sweeps converge to, and like any inelastic impulse it adds no energy;
-    3. the whole impulse J·n acts on both balls, and the planes of every ball the hold moved are
-       driven to their target once more, last (planes win): they take off a held ball the part of J
-       they bear, so the kept impulses balance (the next interval's warm start pushes the held ball
-       into its planes and its planes back).
+    2. a ball pressing a held ball meets it as a ball that can move only along what holds it: the held
+       ball's inverse mass along the contact normal n is |P·n|²/m, P the projection off the directions
+       it is held in (the normals of the planes now pushing it, made orthonormal). The impulse
+       J = (target − v_n)/(1/m_a' + 1/m_b') stops the approach, and like any inelastic impulse it adds
+       no energy. A ball that pressed a held ball is held in turn, along the normals its held ball
+       cannot follow (|P·n|² ≤ ½), and the balls pressing it are met the same way, layer by layer
+       (a heavy ball on a medium one on a light one against a wall);
+    3. the whole impulse J·n acts on both balls, so a held ball is pushed towards what holds it: the
+       layers' contacts are driven to their target again from the top down, and last the planes of
+       every ball the hold moved (planes win). They take off a held ball the part of J they bear, so
+       the kept impulses balance (the next interval's warm start pushes the held ball into its planes
+       and its planes back).
     """
     static = (rows.inv_mass_b == 0.0) & (rows.inv_mass_a > 0.0)
     if not static.any():
         return
-    n = rows.normal
     vn0, vn1 = rows.normal_speeds(v_start), rows.normal_speeds(v)
     r = radius[rows.a]
-    sink = 0.5 * h * (vn0 + vn1)
+    if bend == 1.0:
+        sink = 0.5 * h * (vn0 + vn1)
+    else:
+        sink = h * ((1.0 - 0.5 * bend) * vn0 + (0.5 * bend) * vn1)
     deeper = static & (gap + sink < np.minimum(gap, 0.0) - HOLD_SINK * r)
     if not deeper.any():
         return
@@ -240,50 +265,107 @@ def hold_by_planes(
     held[rows.a[deeper]] = True
     planes = np.flatnonzero(static & held[rows.a])
     _push_off_planes(rows, v, target, normal, planes)
-    slot, basis = _plane_bases(rows, held, planes[normal[planes] > 0.0])
-    pressed = np.flatnonzero(~static & (held[rows.a] | held[rows.b]))
+    # the directions each held ball is held in, made orthonormal (at most three): first the normals of
+    # the planes pushing it
+    slot = np.full(balls, -1)
+    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
+    basis = np.zeros((np.count_nonzero(held), 3, 3))
+    count = np.zeros(len(basis), np.intp)
+    pushing = planes[normal[planes] > 0.0]
+    for group in rows.subset(pushing).colours:  # one contact per ball in each colour
+        _hold_along(basis, count, slot[rows.a[pushing[group]]], rows.normal[pushing[group]])
     moved = held.copy()
-    if pressed.size:
-        sub = rows.subset(pressed)
-        for group in sub.colours:
-            idx = pressed[group]
-            a, b, nk = rows.a[idx], rows.b[idx], n[idx]
-            # each end's normal speed change per unit impulse: 1/m, or |P·n|²/m for a held ball
-            pa = np.where(held[a, None], _off(basis[slot[a]], nk), nk)
-            pb = np.where(held[b, None], _off(basis[slot[b]], nk), nk)
-            inverse = (
-                exact.dot_rows(pa, pa) * rows.inv_mass_a[idx] + exact.dot_rows(pb, pb) * rows.inv_mass_b[idx]
-            )
-            closing = np.maximum(target[idx] - exact.dot_rows(v[a] - v[b], nk), 0.0)
-            j = np.where(inverse > 0.0, closing / np.where(inverse > 0.0, inverse, 1.0), 0.0)
-            normal[idx] += j
-            # the whole impulse acts on both balls; the planes take a held ball's part off it below
-            v[a] += (j * rows.inv_mass_a[idx])[:, None] * nk
-            v[b] -= (j * rows.inv_mass_b[idx])[:, None] * nk
-            moved[a[j > 0.0]] = True
-            moved[b[j > 0.0]] = True
-        v[-1] = 0.0
+    newest, done, layers = held.copy(), static.copy(), []
+    for _ in range(HOLD_LAYERS):
+        pressed = np.flatnonzero(~done & (newest[rows.a] | newest[rows.b]))
+        if pressed.size == 0:
+            break
+        done[pressed] = True
+        layers.append(pressed)
+        j = _press(rows, pressed, held, basis, slot, v, target, normal, moved)
+        # the balls that pressed a held ball are held in turn, along the normals it cannot follow
+        a, b, nk = rows.a[pressed], rows.b[pressed], rows.normal[pressed]
+        new_a = (j > 0.0) & ~held[a] & held[b] & (_free_part(basis[slot[b]], nk) <= 0.5)
+        new_b = (j > 0.0) & ~held[b] & held[a] & (_free_part(basis[slot[a]], nk) <= 0.5)
+        fresh = np.zeros(balls, bool)
+        fresh[a[new_a]] = True
+        fresh[b[new_b]] = True
+        if not fresh.any():
+            break
+        grown = np.flatnonzero(fresh)
+        slot[grown] = len(basis) + np.arange(len(grown))
+        basis = np.concatenate((basis, np.zeros((len(grown), 3, 3))))
+        count = np.concatenate((count, np.zeros(len(grown), np.intp)))
+        ends = np.concatenate((a[new_a], b[new_b]))
+        normals = np.concatenate((nk[new_a], nk[new_b]))
+        joining = pressed[np.concatenate((np.flatnonzero(new_a), np.flatnonzero(new_b)))]
+        for group in rows.subset(joining).colours:  # one contact per ball in each colour
+            _hold_along(basis, count, slot[ends[group]], normals[group])
+        held |= fresh
+        newest = fresh
+    for pressed in reversed(layers[:-1] if len(layers) > 1 else []):  # from the top down
+        _press(rows, pressed, held, basis, slot, v, target, normal, moved)
     last = np.flatnonzero(static & moved[rows.a])
     for _ in range(HOLD_PASSES):  # one is exact against square walls; a few for planes at an angle
         _push_off_planes(rows, v, target, normal, last)
 
 
-def _plane_bases(rows: ContactRows, held: np.ndarray, pushing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The normals of the plane contacts ``pushing`` each ``held`` ball, made orthonormal (Gram–Schmidt,
-    at most three): each held ball's row ``slot`` into ``basis`` (its (3, 3) rows; zero rows unused)."""
-    slot = np.full(len(held), -1)
-    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
-    basis = np.zeros((np.count_nonzero(held), 3, 3))
-    count = np.zeros(len(basis), np.intp)
-    for group in rows.subset(pushing).colours:  # one contact per ball in each colour
-        k = slot[rows.a[pushing[group]]]
-        u = _off(basis[k], rows.normal[pushing[group]])
-        length = exact.norm_rows(u)
-        ok = (length > NEW_DIRECTION) & (count[k] < 3)
-        k = k[ok]
-        basis[k, count[k]] = u[ok] / length[ok, None]
-        count[k] += 1
-    return slot, basis
+def _free_part(basis: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """|P·n|²: how much of each unit normal ``n`` a held ball (held along the rows of ``basis``) can
+    follow."""
+    u = _off(basis, n)
+    return exact.dot_rows(u, u)
+
+
+def _hold_along(basis: np.ndarray, count: np.ndarray, k: np.ndarray, n: np.ndarray) -> None:
+    """Add the directions ``n`` (one per row; the rows ``k`` of ``basis`` all different) to the held
+    directions, made orthonormal, where they are not already within them."""
+    u = _off(basis[k], n)
+    length = exact.norm_rows(u)
+    ok = (length > NEW_DIRECTION) & (count[k] < 3)
+    k = k[ok]
+    basis[k, count[k]] = u[ok] / length[ok, None]
+    count[k] += 1
+
+
+def _press(
+    rows: ContactRows,
+    pressed: np.ndarray,
+    held: np.ndarray,
+    basis: np.ndarray,
+    slot: np.ndarray,
+    v: np.ndarray,
+    target: np.ndarray,
+    normal: np.ndarray,
+    moved: np.ndarray,
+) -> np.ndarray:
+    """Drive the contacts ``pressed`` up to their target, colour by colour, a held end meeting the
+    impulse with its inverse mass along the normal only (|P·n|²/m); the whole impulse acts on both
+    balls. Returns each contact's impulse (the balls it moved are marked in ``moved``)."""
+    n = rows.normal
+    out = np.zeros(len(pressed))
+    sub = rows.subset(pressed)
+    for group in sub.colours:
+        idx = pressed[group]
+        a, b, nk = rows.a[idx], rows.b[idx], n[idx]
+        # each end's normal speed change per unit impulse: 1/m, or |P·n|²/m for a held ball
+        pa = np.where(held[a, None], _off(basis[slot[a]], nk), nk)
+        pb = np.where(held[b, None], _off(basis[slot[b]], nk), nk)
+        dot = exact.dot_rows
+        inverse = dot(pa, pa) * rows.inv_mass_a[idx] + dot(pb, pb) * rows.inv_mass_b[idx]
+        closing = np.maximum(target[idx] - dot(v[a] - v[b], nk), 0.0)
+        # both ends held along n (rounding leaves |P·n|² of 1e-17, not 0): nothing can give
+        free = inverse > HELD_ALONG * (rows.inv_mass_a[idx] + rows.inv_mass_b[idx])
+        j = np.where(free, closing / np.where(free, inverse, 1.0), 0.0)
+        normal[idx] += j
+        out[group] = j
+        # a held end moves only along what holds it (P·n): what holds it takes the rest
+        v[a] += (j * rows.inv_mass_a[idx])[:, None] * pa
+        v[b] -= (j * rows.inv_mass_b[idx])[:, None] * pb
+        moved[a[j > 0.0]] = True
+        moved[b[j > 0.0]] = True
+    v[-1] = 0.0
+    return out
 
 
 def _off(basis: np.ndarray, n: np.ndarray) -> np.ndarray:

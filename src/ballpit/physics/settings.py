@@ -242,6 +242,12 @@ WARM_START_SPAN = 0.5
 HOLD_SINK = 0.01
 # Sweeps over a held ball's plane contacts after the hold: exact after one against square walls.
 HOLD_PASSES = 3
+# The hold reaches this many layers of balls out from a held ball's planes (a chain pressing it).
+HOLD_LAYERS = 8
+# A contact between two balls both held along its normal gives way to no impulse: its ends' inverse
+# masses along the normal, |P·n|²/m (rounding leaves 1e-17 of them, not 0), are below this fraction of
+# their whole 1/m (dimensionless).
+HELD_ALONG = 1e-9
 
 # --- Sleeping (sleeping.py) -------------------------------------------------------------------------
 

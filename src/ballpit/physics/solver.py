@@ -49,6 +49,10 @@ class _Colour:
         self.spin = np.ascontiguousarray(contacts.spin[idx].T) if contacts.moving else None
         self.has_friction = bool(self.mu.any())
         self.has_rolling = bool(self.rolling.any())
+        # how a unit of friction's turn changes the relative spin (c = ρ_a/I_a − ρ_b/I_b), and a bound
+        # on the surface speed a unit of rolling impulse changes (|ΔΩ|·ρ), for the convergence test
+        self.lever = self.ra * self.iia - self.rb * self.iib
+        self.max_roll = float((self.iia * self.ra + self.iib * self.rb).max())
 
 
 def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -137,7 +141,31 @@ def _sweep_colour(
     linear = d_n * c.n
     change = float(np.abs(d_n).max()) * c.max_inv_m_n
 
-    if c.has_friction:
+    if c.has_friction and c.has_rolling:
+        # friction and rolling resistance together: where both stay within their limits the block
+        # stops slip and relative spin at once (a ball coming to rest stops); elsewhere one after the
+        # other, as below
+        slip = rel - vn * c.n
+        spin = wa - wb if c.spin is None else wa - wb - c.spin
+        p, r = model.stick(slip, spin, c.n, c.ima, c.imb, c.iia, c.iib, c.ra, c.rb)
+        old_t, old_r = friction[k], rolling[k]
+        block_t, block_r = old_t + p, old_r + r
+        new_t = model.within_limit(old_t - c.m_t * slip, c.mu * new)
+        d_t = new_t - old_t
+        spin -= c.lever * model.turn(c.n, d_t)  # the relative spin after that friction's turn
+        new_r = model.within_limit(old_r - c.m_r * spin, c.rolling * new)
+        held = (exact.dot_cols(block_t, block_t) <= (c.mu * new) ** 2) & (
+            exact.dot_cols(block_r, block_r) <= (c.rolling * new) ** 2
+        )
+        new_t, new_r = np.where(held, block_t, new_t), np.where(held, block_r, new_r)
+        friction[k], rolling[k] = new_t, new_r
+        d_t, d_r = new_t - old_t, new_r - old_r
+        linear += d_t
+        turn = model.turn(c.n, d_t)
+        wa += c.turn_a * turn + c.iia * d_r
+        wb += c.turn_b * turn - c.iib * d_r
+        change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t, float(np.abs(d_r).max()) * c.max_roll)
+    elif c.has_friction:
         # friction cancels slip (the tangential part of rel, which the normal impulse leaves alone)
         old_t = friction[k]
         new_t = model.within_limit(old_t - c.m_t * (rel - vn * c.n), c.mu * new)
@@ -148,9 +176,8 @@ def _sweep_colour(
         wa += c.turn_a * turn
         wb += c.turn_b * turn
         change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t)
-
-    if c.has_rolling:
-        # rolling resistance opposes relative spin (after the friction turn), up to ρ_roll·P_n
+    elif c.has_rolling:
+        # rolling resistance opposes relative spin, up to ρ_roll·P_n
         old_r = rolling[k]
         spin = wa - wb if c.spin is None else wa - wb - c.spin
         new_r = model.within_limit(old_r - c.m_r * spin, c.rolling * new)
@@ -158,6 +185,7 @@ def _sweep_colour(
         d_r = new_r - old_r
         wa += c.iia * d_r
         wb -= c.iib * d_r
+        change = max(change, float(np.abs(d_r).max()) * c.max_roll)
 
     va += c.ima * linear
     vb -= c.imb * linear

@@ -1,4 +1,4 @@
-"""The viewer: a pyglet window with instanced OpenGL 3.3 rendering, and offscreen rendering to GIF/PNG.
+"""The viewer: a pyglet window with instanced OpenGL 3.3 rendering, and offscreen rendering to MP4/GIF/PNG.
 
 Entry points (imported lazily by the CLI): ``ballpit.viewer.app.run(scene_path)`` opens the window;
 ``ballpit.viewer.render.render(scene_path, out, ...)`` renders headless through EGL. A process uses

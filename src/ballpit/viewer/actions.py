@@ -106,6 +106,7 @@ HANDLERS: dict[Enum, Handler] = {
     Action.SHOT_SPEED: _shot_speed,
     Action.HOME: _home,
     Action.SAVE: lambda v: v.save_scene(),
+    Action.RECORD_VIDEO: lambda v: v.video.toggle(),
     Action.PANEL: _panel,
     **{action: _command(fn) for action, fn in controls.TIME_ACTIONS.items()},
     **{

@@ -78,6 +78,7 @@ class Viewer:
         from .renderer import Renderer
         from .screen import ScreenOverlay
         from .stepper import PhysicsThread, tuning_from
+        from .video import VideoRecorder
         from .view_control import ViewControl
         from .watch import Traces
 
@@ -119,6 +120,8 @@ class Viewer:
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
         self.screen = ScreenOverlay(self.window, self.physics)
+        flash = lambda message: self.hud.flash(message, time.perf_counter())  # noqa: E731
+        self.video = VideoRecorder(self.window, flash, left=lambda: self.panel.width)  # right of the panel
         self._interaction_seconds: deque[float] = deque()
         self._interaction_input: tuple = ()
         self._interaction_queued = False
@@ -263,8 +266,8 @@ class Viewer:
         self.command(lambda sim: (sim.reload(), sim.error)[1], self.hud.set_error)
 
     def save_scene(self, path: Path | None = None) -> None:
-        """Ctrl+S: write the scene as it stands to a new file beside the original (or to ``path``, the
-        panel's Save as); the HUD says where."""
+        """Ctrl+S: write the scene as it stands to a new file beside the original (a bundled scene: in
+        the current directory, save.py), or to ``path`` (the panel's Save as); the HUD says where."""
         camera = copy.deepcopy(self.camera)
 
         def save(sim: Simulation) -> Path | OSError:
@@ -306,7 +309,8 @@ class Viewer:
     def finish_record(self) -> None:
         """Write the ``--record`` file (once), when the window closes or the run is interrupted: the
         steps finished by then, up to the one shown (a step still in progress on the physics thread, or
-        taken ahead of what the window shows, is left out)."""
+        taken ahead of what the window shows, is left out). A video being recorded is finished too."""
+        self.video.stop()
         if self.recorder is not None and not self.recorder.finished:
             shown, sim = self.physics.shown, self.sim
             ahead = sim.phase is Phase.RUNNING and shown.generation == sim.generation  # may have run ahead
@@ -373,6 +377,7 @@ class Viewer:
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
+        self.video.frame(shown.time, shown.hud is None or shown.hud.running, width, height)
         self._count_frame(now, shown)
 
     def _view_key(self, shown: Shown, width: int, height: int) -> tuple | None:

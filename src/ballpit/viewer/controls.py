@@ -49,6 +49,7 @@ class Action(Enum):
     SHOT_SPEED = "change the shot speed"
     HOME = "camera back to the scene's view"
     SAVE = "save the scene as it stands to a new file"
+    RECORD_VIDEO = "record the 3-D view to MP4 / stop"
     PANEL = "show / hide the panel"
 
 
@@ -69,6 +70,7 @@ KEY_ACTIONS: dict[str, Action] = {
     "F2": Action.PROFILE,
     "F3": Action.QUALITY,
     "F12": Action.SCREENSHOT,
+    "F9": Action.RECORD_VIDEO,
     "LEFT": Action.STEP_BACK,
     "G": Action.GHOSTS,
     "P": Action.ENERGY_PLOT,
@@ -126,6 +128,7 @@ FLY_SPEED_RANGE = (0.05, 500.0)
 # A second Esc within this many seconds quits; the HUD asks for it as long.
 QUIT_CONFIRM_SECONDS = 2.0
 QUIT_HINT = "press Esc again to quit"
+RELEASED_HINT = "mouse released (Tab captures it again)"
 
 # Time scale (simulated seconds per real second) steps by a factor of 2 within these bounds.
 TIME_SCALE_RANGE = (1.0 / 64.0, 8.0)
@@ -143,6 +146,7 @@ HELP: tuple[tuple[str, str], ...] = (
     ("C / V / T, P", "contacts, velocities, trails; energy plot"),
     ("H / F1 F2 F3 F4", "HUD, help, stage times, quality, panel"),
     ("F12 / Ctrl+S", "screenshot into screenshots/ / save the scene"),
+    ("F9", "record MP4 into videos/ (F9 again stops)"),
     ("left-drag a ball", "pick it up and move it; let go to throw it"),
     ("B / Shift+B", "shoot a ball along the view / its speed"),
     ("click a plane", "select it: arrows tilt it, PgUp/PgDn lift it"),
@@ -222,7 +226,7 @@ def slower(scale: float) -> float:
 def escape_outcome(mouse_captured: bool, armed: bool = False) -> str:
     """What Esc does: release a captured mouse ("release"); with nothing captured, quit only if Esc was
     pressed in the last ``QUIT_CONFIRM_SECONDS`` (``armed``: "quit"), else ask for a second Esc ("arm").
-    Releasing the mouse arms the quit too: Esc releases it, Esc again quits."""
+    Releasing the mouse does nothing else: quitting still takes Esc, Esc after it."""
     if mouse_captured:
         return "release"
     return "quit" if armed else "arm"

@@ -12,6 +12,10 @@ from collections import deque
 import numpy as np
 
 WINDOW_SECONDS = 10.0
+# Kinetic and potential energy: pink and lavender, apart from every integrator's colour (red, orange,
+# blue, green: physics/integrators.py), which the totals take.
+KINETIC_COLOR = (1.0, 0.5, 0.9, 1.0)
+POTENTIAL_COLOR = (0.72, 0.62, 1.0, 1.0)
 
 
 class EnergyWindow:

@@ -10,7 +10,7 @@ import numpy as np
 
 from . import overlays
 from .handover import Needs, Shown, capture
-from .renderer import Renderer
+from .renderer import Renderer, solid_planes
 from .simulation import Simulation
 
 
@@ -30,6 +30,7 @@ class FrameFeeder:
         self.renderer = renderer
         self._generation: int | None = None
         self._plane_pose = np.zeros((0, 7))
+        self._solid = np.zeros(0, dtype=bool)  # the planes that are floors or slopes (renderer.py)
         self.plane_uploads = 0  # how many times the plane quads were rebuilt (tests read it)
         self.upload_seconds = 0.0
 
@@ -52,18 +53,21 @@ class FrameFeeder:
             shown = capture(sim, needs)
         pose = np.hstack([shown.plane_centers, shown.plane_orientations])
         changed = shown.generation != self._generation
+        if changed or len(self._solid) != len(pose):  # which planes are solid: as the scene starts
+            self._solid = solid_planes(shown.plane_orientations, shown.plane_half_sizes)
         if changed or pose.shape != self._plane_pose.shape or not np.array_equal(pose, self._plane_pose):
             self.renderer.set_planes(shown.plane_centers, shown.plane_orientations, shown.plane_half_sizes,
-                                     shown.appearance.plane_colors)  # fmt: skip
+                                     shown.appearance.plane_colors, self._solid)  # fmt: skip
             self._generation, self._plane_pose = shown.generation, pose
             self.plane_uploads += 1
         positions = shown.positions
         self.renderer.upload_balls(positions, shown.orientations, shown.radii, shown.sphere_colors, eye)
         self._upload_ghosts(shown)
 
-        world_lines, overlay_lines = overlays.empty(), overlays.empty()
+        trails, overlay_lines = overlays.empty(), overlays.empty()
         if flags.trails and shown.trails is not None and shown.trails.shape[1] == len(positions):
-            world_lines = overlays.trail_lines(shown.trails, shown.sphere_colors, positions)
+            eye = shown.plane_centers.mean(axis=0) + (0, 1e3, 0) if eye is None else eye  # no eye: from above
+            trails = overlays.trail_ribbons(shown.trails, shown.sphere_colors, shown.radii, eye, positions)
         parts = []
         if flags.contacts and shown.contact_points is not None:
             parts.append(overlays.contact_lines(shown.contact_points, shown.contact_normals))
@@ -73,7 +77,7 @@ class FrameFeeder:
             parts.append(extra_lines)
         if parts:
             overlay_lines = np.concatenate(parts)
-        self.renderer.upload_lines(world_lines, overlay_lines)
+        self.renderer.upload_lines(trails, overlay_lines)
         self.upload_seconds = time.perf_counter() - started
 
     def _upload_ghosts(self, shown: Shown) -> None:

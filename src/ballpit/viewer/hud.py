@@ -8,6 +8,7 @@ small for both shows the help alone).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import pyglet
@@ -17,12 +18,16 @@ from .handover import HudFacts
 from .simulation import Simulation
 
 FONT = ("DejaVu Sans Mono", "Menlo", "Consolas", "Courier New", "monospace")
-FONT_SIZE = 11
+FONT_SIZE = 11  # points in a window of REFERENCE_SIZE; the HUD's text scales with the window (font_size)
+REFERENCE_SIZE = (1280, 720)
+FONT_SIZE_RANGE = (7.0, 22.0)  # points: still readable when small, not a poster when huge
 TEXT_COLOR = (235, 238, 245, 255)
 ERROR_COLOR = (255, 110, 100, 255)
 PANEL_COLOR = (10, 12, 18, 190)
 ERROR_BACK = (10, 12, 18, 225)  # the dark box under the error text, so red reads on the grey ground
 MARGIN = 10
+HELP_PAD = (40, 30)  # px the help's panel adds round its text (width, height)
+HELP_MIN_FONT_SIZE = 6.0  # points: the help shrinks to fit beside the panel, not below this
 NO_WRAP = 4000  # px: labels wider than any window, so lines break only where the text says
 MESSAGE_SECONDS = 3.0
 
@@ -65,10 +70,24 @@ def profile_lines(sim: Simulation | HudFacts, drawn: Sequence[str] = ()) -> list
     return [f"{f.name}: step profile, {f.profile[0]}", *f.profile[1:], *drawn, "F2 back  H hide"]
 
 
+def font_size(width: int, height: int) -> float:
+    """The HUD's font size (points) in a ``width`` x ``height`` window: FONT_SIZE at REFERENCE_SIZE,
+    scaled by the side that shrank most (so the HUD keeps its share of the window), within
+    FONT_SIZE_RANGE, in half points (each size is laid out once, not at every pixel of a drag)."""
+    scale = min(width / REFERENCE_SIZE[0], height / REFERENCE_SIZE[1])
+    low, high = FONT_SIZE_RANGE
+    return min(max(round(2.0 * FONT_SIZE * scale) / 2.0, low), high)
+
+
+# What a finite plane's colour says (scene/colours.py's ramp): its restitution, at the ramp's three
+# stops. Most scenes' planes lie between them (the demo's slopes 0.55-0.95: green to orange).
+PLANE_LEGEND = "plane colour = restitution: 0 slate blue (dead), 0.5 green, 1 orange (bouncy)"
+
+
 def help_text() -> str:
     width = max(len(keys) for keys, _ in HELP)
     rows = [f"{keys:<{width}}  {what}" for keys, what in HELP]
-    return "\n".join(["ballpit controls", "", *rows, "", "plane colour: blue dead → green → orange bouncy"])
+    return "\n".join(["ballpit controls", "", *rows, "", PLANE_LEGEND])
 
 
 class Hud:
@@ -111,8 +130,13 @@ class Hud:
         self.layout()
 
     def layout(self) -> None:
-        """Place the labels for the window's current size."""
+        """Place the labels for the window's current size, their text scaled to it (``font_size``)."""
         w, h = self.window.width, self.window.height
+        size = font_size(w, h)
+        for label in (self.label, self.error_label, self.message_label):
+            if label.font_size != size:
+                label.font_size = size
+        self._size_help(size, w - self.left - 2 * MARGIN - HELP_PAD[0])
         left = self.left + MARGIN
         self.label.x, self.label.y = left + 6, h - MARGIN - 4
         self.error_label.width = max(w - self.left - 2 * MARGIN, 100)
@@ -126,6 +150,19 @@ class Hud:
         )
         self._fit_panel()
 
+    def _size_help(self, size: float, room: float) -> None:
+        """The help's text at the HUD's ``size``, smaller if its lines would be wider than the ``room``
+        (px) right of the panel (down to HELP_MIN_FONT_SIZE)."""
+        help_label = self.help_label
+        if help_label.font_size != size:
+            help_label.font_size = size
+        if help_label.content_width > room:  # text widths scale with the font size
+            smaller = math.floor(2.0 * size * room / help_label.content_width) / 2.0
+            help_label.font_size = max(smaller, HELP_MIN_FONT_SIZE)
+        if help_label.width != help_label.content_width + 2:
+            help_label.width = help_label.content_width + 2
+            self._help_layout_key = ()
+
     def _fit_panel(self) -> None:
         h = self.window.height
         pw, ph = self.label.content_width + 14, self.label.content_height + 10
@@ -134,17 +171,17 @@ class Hud:
         self._place_help()
 
     def _place_help(self) -> None:
-        """Put the help panel where it does not cover the HUD panel: centred in the window if it is
-        clear of it there, else in the room right of it, else below it; if the window has room for
-        none of these the help is drawn alone (``help_hides_hud``)."""
+        """Put the help panel where it does not cover the HUD panel: centred in the 3-D view (right of
+        the ImGui panel) if it is clear of it there, else in the room right of it, else below it; if
+        the window has room for none of these the help is drawn alone (``help_hides_hud``)."""
         w, h = self.window.width, self.window.height
         panel = self.panel
-        key = (w, h, self.show_hud, panel.x, panel.y, panel.width, panel.height)
+        key = (w, h, self.left, self.show_hud, panel.x, panel.y, panel.width, panel.height)
         if key == self._help_layout_key:
             return
         self._help_layout_key = key
-        hw, hh = self.help_label.content_width + 40, self.help_label.content_height + 30
-        x = w // 2 - hw // 2
+        hw, hh = self.help_label.content_width + HELP_PAD[0], self.help_label.content_height + HELP_PAD[1]
+        x = max(self.left + (w - self.left) // 2 - hw // 2, self.left + MARGIN)
         y = min(max(h // 2 - hh // 2, MARGIN), h - MARGIN - hh)  # centred, kept on screen if it fits
         hud_right, hud_bottom = panel.x + panel.width + MARGIN, panel.y - MARGIN
         self.help_hides_hud = False

@@ -72,8 +72,8 @@ class WindowInput:
         self.held.clear()
 
     def escape(self) -> None:
-        """Esc: release a captured mouse, else quit only on a second Esc within a couple of seconds;
-        until then the HUD asks for it."""
+        """Esc: release a captured mouse (and nothing else), else quit only on a second Esc within a
+        couple of seconds; until then the HUD asks for it."""
         v = self.viewer
         now = time.perf_counter()
         if not self.mouse_captured and v.interaction.selected_plane is not None:
@@ -86,6 +86,8 @@ class WindowInput:
             return
         if outcome == "release":
             self.capture_mouse(False)
+            v.hud.flash(controls.RELEASED_HINT, now)
+            return
         self._quit_armed_until = now + controls.QUIT_CONFIRM_SECONDS
         v.hud.flash(controls.QUIT_HINT, now, seconds=controls.QUIT_CONFIRM_SECONDS)
 

@@ -151,7 +151,8 @@ class Interaction:
         if hit.kind == "plane":
             self.select(hit.index)
             self.selected_ball = None
-            return f"plane #{hit.index + 1} selected: arrows tilt it, PgUp/PgDn raise and lower it"
+            # numbered as world.planes and the events' b (plane index) count them: from 0
+            return f"plane {hit.index} selected: arrows tilt it, PgUp/PgDn raise and lower it"
         self.deselect()
         self.selected_ball = hit.index
         if self.in_replay:
@@ -335,5 +336,5 @@ class Interaction:
             speed = float(np.linalg.norm(self.throw_velocity()))
             lines.append(f"holding     ball {self.held_ball}, throw {speed:.2f} m/s")
         if self.selected_plane is not None:
-            lines.append(f"selected    plane #{self.selected_plane + 1}: arrows PgUp PgDn")
+            lines.append(f"selected    plane {self.selected_plane}: arrows PgUp PgDn")
         return lines

@@ -1,7 +1,8 @@
-"""Debug overlays as line vertices: contact points and normals, velocity arrows, trails.
+"""Debug overlays as vertices (x, y, z, r, g, b, a): contact points and normals, velocity arrows, trails.
 
-Each builder returns a float32 array of shape (2·segments, 7): pairs of vertices (x, y, z, r, g, b, a)
-ready for one ``GL_LINES`` draw. Everything is vectorised over contacts and balls.
+The contact marks and arrows are pairs of vertices, float32 (2·segments, 7), ready for one ``GL_LINES``
+draw. Trails are ribbons, one triangle strip for all balls (``trail_ribbons``): OpenGL's core profile
+draws lines one pixel wide, too faint to follow. Everything is vectorised over contacts and balls.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ CONTACT_CROSS = 0.06  # half length of the cross marking a contact point, m
 NORMAL_LENGTH = 0.35  # m
 VELOCITY_SCALE = 0.12  # metres of arrow per m/s
 ARROW_HEAD = 0.25  # head length as a fraction of the arrow
+TRAIL_WIDTH = 0.6  # ball radii: a trail's width at its newest end; it narrows to a third at its oldest
+TRAIL_ALPHA = 0.9  # opacity at the newest end; it fades to nothing at the oldest
 
 
 def empty() -> np.ndarray:
@@ -79,25 +82,40 @@ def velocity_arrows(positions: np.ndarray, velocities: np.ndarray, min_speed: fl
     return _segments(starts, ends, np.broadcast_to(VELOCITY_COLOR, (len(starts), 4)))
 
 
-def trail_lines(samples: np.ndarray, colors: np.ndarray, current: np.ndarray | None = None) -> np.ndarray:
-    """Lines through each ball's recent positions, fading out towards the oldest.
+def trail_ribbons(
+    samples: np.ndarray,
+    colors: np.ndarray,
+    radii: np.ndarray,
+    eye: np.ndarray,
+    current: np.ndarray | None = None,
+) -> np.ndarray:
+    """Each ball's recent path as a ribbon facing the eye, for one ``GL_TRIANGLE_STRIP`` draw: as wide as
+    ``TRAIL_WIDTH`` of the ball at the ball, narrower and more transparent towards the oldest sample.
 
-    ``samples`` is (L, N, 3) oldest first; ``colors`` (N, 3); ``current`` (N, 3) joins the newest sample
-    to where the ball is drawn now.
+    ``samples`` is (L, N, 3) oldest first; ``colors`` (N, 3); ``radii`` (N,); ``current`` (N, 3) joins
+    the newest sample to where the ball is drawn now. Each ball's strip repeats its first and last
+    vertex, so the triangles joining one strip to the next have no area.
     """
-    samples = np.asarray(samples, dtype=np.float32)
+    points = np.asarray(samples, dtype=np.float32)
     if current is not None:
-        samples = np.concatenate([samples, np.asarray(current, dtype=np.float32)[None]])
-    length, count = samples.shape[:2]
+        points = np.concatenate([points, np.asarray(current, dtype=np.float32)[None]])
+    length, count = points.shape[:2]
     if length < 2 or count == 0:
         return empty()
-    starts = samples[:-1].reshape(-1, 3)
-    ends = samples[1:].reshape(-1, 3)
-    fade = np.linspace(0.0, 0.9, length, dtype=np.float32)
-    rgb = np.asarray(colors, dtype=np.float32)[None, :, :]
-    start_alpha = np.broadcast_to(fade[:-1, None, None], (length - 1, count, 1))
-    end_alpha = np.broadcast_to(fade[1:, None, None], (length - 1, count, 1))
-    rgb = np.broadcast_to(rgb, (length - 1, count, 3))
-    start_colors = np.concatenate([rgb, start_alpha], axis=-1).reshape(-1, 4)
-    end_colors = np.concatenate([rgb, end_alpha], axis=-1).reshape(-1, 4)
-    return _segments(starts, ends, np.stack([start_colors, end_colors]))
+    tangent = np.empty_like(points)  # along the path: central differences, one-sided at the ends
+    tangent[1:-1] = points[2:] - points[:-2]
+    tangent[0], tangent[-1] = points[1] - points[0], points[-1] - points[-2]
+    side = np.cross(tangent, points - np.asarray(eye, dtype=np.float32))  # across the path, facing the eye
+    norm = np.linalg.norm(side, axis=-1, keepdims=True)
+    side = np.divide(side, norm, out=np.zeros_like(side), where=norm > 1e-12)  # a ball at rest: no width
+    grow = np.linspace(0.0, 1.0, length, dtype=np.float32)[:, None]  # 0 at the oldest sample, 1 now
+    half = 0.5 * TRAIL_WIDTH * np.asarray(radii, dtype=np.float32)[None, :] * (1.0 + 2.0 * grow) / 3.0
+    strip = np.empty((count, length, 2, VERTEX_WIDTH), dtype=np.float32)
+    offset = (side * half[..., None]).transpose(1, 0, 2)  # (N, L, 3)
+    along = points.transpose(1, 0, 2)
+    strip[:, :, 0, :3] = along - offset
+    strip[:, :, 1, :3] = along + offset
+    strip[..., 3:6] = np.asarray(colors, dtype=np.float32)[:, None, None, :]
+    strip[..., 6] = (TRAIL_ALPHA * grow[:, 0])[None, :, None]
+    strip = strip.reshape(count, 2 * length, VERTEX_WIDTH)
+    return np.concatenate([strip[:, :1], strip, strip[:, -1:]], axis=1).reshape(-1, VERTEX_WIDTH)

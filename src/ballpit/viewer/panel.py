@@ -26,9 +26,11 @@ from ..scene import bundled_scenes
 from . import actions
 from .controls import Action, IntegratorAction
 from .edits import AT_ONCE, ON_RESET, Edits
+from .energyplot import KINETIC_COLOR, POTENTIAL_COLOR
 from .ghosts import LABELS, TINTS
 from .panel_backend import PanelBackend
 from .simulation import Phase
+from .video import REC_COLOR
 from .watch import BallFacts, PlaneFacts, Watch
 
 if TYPE_CHECKING:
@@ -40,13 +42,13 @@ PROMPT = "press X or click Drop"
 PROMPT_SIZE = 40.0  # px, the first minute's prompt
 ERROR = ImVec4(1.0, 0.45, 0.4, 1.0)
 MUTED = ImVec4(0.65, 0.68, 0.75, 1.0)
+REC = ImVec4(*(c / 255 for c in REC_COLOR))  # the recording mark, as the window's
 PLOT_HEIGHT = 200
 RECENT_LIMIT = 8
 DIALOG_TOOLS = ("zenity", "kdialog", "matedialog", "qarma")  # what portable_file_dialogs runs on Linux
 PLOTS = ("energy", "ball", "contacts", "stages")
 LEGEND = implot.LegendFlags_.outside | implot.LegendFlags_.horizontal  # never over the curves
-# pink and lavender: apart from every integrator's colour (red, orange, blue, green)
-KINETIC, POTENTIAL = ImVec4(1.0, 0.5, 0.9, 1.0), ImVec4(0.72, 0.62, 1.0, 1.0)
+KINETIC, POTENTIAL = ImVec4(*KINETIC_COLOR), ImVec4(*POTENTIAL_COLOR)
 
 
 def has_file_dialog() -> bool:
@@ -250,7 +252,9 @@ class Panel:
 
     # ------------------------------------------------------------------ widgets
     def _action_button(self, action: object, text: str, key: str | None = None) -> bool:
-        clicked = imgui.button(actions.label(action, text))
+        """A button that runs ``action``, labelled ``text`` and its keys; ``key`` names a button whose
+        text changes (Pause / Resume) with one ImGui id and one place in ``rects``."""
+        clicked = imgui.button(actions.label(action, text) + (f"###{key}" if key else ""))
         self._remember(key or text)
         if imgui.is_item_hovered():
             imgui.set_tooltip(str(action.value))
@@ -533,6 +537,7 @@ class Panel:
             for name in sorted(totals, key=lambda n: n == main):  # the run's own total on top
                 label = LABELS.get(name, name) if len(totals) > 1 else "E"
                 implot.plot_line(label, t, e[f"total {name}"], _spec((*TINTS[name], 1.0), 2.0))
+            self._remember_legend("energy")
             implot.end_plot()
         if self.plots["ball"] and implot.begin_plot("selected ball", size):
             self._remember("plot area ball")
@@ -561,6 +566,13 @@ class Panel:
                 spec.flags = implot.BarsFlags_.horizontal
                 implot.plot_bars("stage", np.array(list(traces.stages.values())), 0.67, 0, spec)
                 implot.end_plot()
+
+    def _remember_legend(self, name: str) -> None:
+        """Keep the plot's frame and its legend's rectangle as ImPlot laid them out (the last frame's),
+        so the tests can check that the legend is not clipped."""
+        plot = implot.internal.get_current_plot()
+        for key, rect in ((f"frame {name}", plot.frame_rect), (f"legend {name}", plot.items.legend.rect)):
+            self.rects[key] = (rect.min.x, rect.min.y, rect.get_width(), rect.get_height())
 
     # ------------------------------------------------------------------ View
     def _view(self, shown: Shown, watch: Watch) -> None:
@@ -602,9 +614,33 @@ class Panel:
 
     # ------------------------------------------------------------------ Record video
     def _record(self, shown: Shown, watch: Watch) -> None:
-        # The MP4 recorder (viewer/video.py) comes from its own branch: its button goes here.
-        imgui.begin_disabled()
-        imgui.button("Record MP4")
-        imgui.end_disabled()
-        self._remember("Record MP4")
-        imgui.text_colored(MUTED, "MP4 recording is not in this build yet")
+        """The MP4 button (F9's action) and the recorder's state: the seconds of video so far, the file
+        written, or why it could not record (the run goes on either way)."""
+        video = self.viewer.video
+        text = "Stop recording" if video.is_recording else "Record MP4"
+        self._action_button(Action.RECORD_VIDEO, text, key="Record MP4")
+        writer = video.writer  # after the click: it may have started or stopped the recording
+        imgui.push_text_wrap_pos(0.0)
+        if writer is not None:
+            imgui.same_line()
+            imgui.push_style_color(imgui.Col_.text, REC)
+            imgui.bullet_text(f"REC {writer.duration:.1f} s")  # ImGui's font has no ●: its own bullet
+            imgui.pop_style_color()
+            self._remember("recording")
+            imgui.text_colored(MUTED, f"to {writer.path.name}")
+        elif video.error:
+            imgui.text_colored(ERROR, video.error)
+            self._remember("error video")
+        elif video.last_video is not None:
+            done = video.last_video
+            if done.frames:
+                imgui.text(f"saved {done.path.name}: {done.frames} frames, {done.seconds:.2f} s")
+            else:
+                imgui.text("stopped: no simulated time ran, nothing written")
+            self._remember("video saved")
+        imgui.text_colored(
+            MUTED,
+            "Into videos/: the 3-D view and the HUD, not this panel, one frame per 1/30 s of simulated "
+            "time (it plays at the run's speed; paused time adds nothing).",
+        )
+        imgui.pop_text_wrap_pos()

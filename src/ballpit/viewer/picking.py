@@ -13,6 +13,11 @@ import numpy as np
 
 from .camera import WORLD_UP, Camera
 
+# m: an infinite plane is picked only this near the eye. Beyond it the fog (renderer.FOG_DENSITY,
+# 0.02/m) leaves under a tenth of it visible, exp(-(0.02 * 76)^2) = 0.1, so a click on what looks like
+# the sky just above the horizon does not select the ground hundreds of metres away (and tint it all).
+INFINITE_PICK_DISTANCE = 76.0
+
 
 @dataclass(frozen=True)
 class Ray:
@@ -85,7 +90,8 @@ def ray_planes(
     half_sizes: np.ndarray,
 ) -> tuple[int, float]:
     """The first plane (finite rectangle or infinite plane) the ray crosses, from either side:
-    (index, distance along the ray), or (-1, inf)."""
+    (index, distance along the ray), or (-1, inf). An infinite plane counts only within
+    ``INFINITE_PICK_DISTANCE``."""
     centers = np.asarray(centers, dtype=float).reshape(-1, 3)
     if len(centers) == 0:
         return -1, math.inf
@@ -100,6 +106,7 @@ def ray_planes(
     v = np.einsum("ij,ij->i", local, np.asarray(axis_v, dtype=float).reshape(-1, 3))
     half = np.asarray(half_sizes, dtype=float).reshape(-1, 2)
     inside = (np.abs(u) <= half[:, 0]) & (np.abs(v) <= half[:, 1])
+    inside &= np.isfinite(half).all(axis=1) | (t <= INFINITE_PICK_DISTANCE)
     t = np.where(inside, t, np.inf)
     k = int(np.argmin(t))
     return (k, float(t[k])) if np.isfinite(t[k]) else (-1, math.inf)

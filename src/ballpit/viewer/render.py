@@ -1,9 +1,10 @@
-"""Offscreen rendering to a GIF or PNGs through pyglet's headless EGL mode: no display needed.
+"""Offscreen rendering to an MP4, a GIF or PNGs through pyglet's headless EGL mode: no display needed.
 
 ``render`` switches this process to headless GL (it cannot open a window afterwards; see backend.py),
 starts the drop at once and steps the physics exactly 1/fps of simulated time per frame, whatever the
-wall time. Output by ``out``: ``*.gif`` an animated GIF, ``*.png`` one PNG of the last frame, a
-directory (existing, ending in ``/`` or without a suffix) numbered PNG frames ``frame_0000.png``, ...
+wall time. Output by ``out``: ``*.mp4`` an H.264 video (mp4.py; it needs PyAV), ``*.gif`` an animated
+GIF, ``*.png`` one PNG of the last frame, a directory (existing, ending in ``/`` or without a suffix)
+numbered PNG frames ``frame_0000.png``, ...
 """
 
 from __future__ import annotations
@@ -12,7 +13,10 @@ import itertools
 import math
 import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,10 +24,13 @@ from . import backend
 from .camera import Camera
 from .simulation import Simulation
 
-OUTPUT_KINDS = "a .gif file, a .png file or a directory (ending in /) for PNG frames"
+if TYPE_CHECKING:
+    from .mp4 import Mp4Writer
+
+OUTPUT_KINDS = "a .mp4 file, a .gif file, a .png file or a directory (ending in /) for PNG frames"
 # A GIF is written at the end from all its frames, which stay in memory until then (Pillow needs them
 # together): at most this many bytes of them (one byte a pixel), 34 s at 960x540 and 30 fps. PNG frames
-# go to disk one by one, at most MAX_FRAMES of them (55 min at 30 fps).
+# and MP4 frames go to disk one by one, at most MAX_FRAMES of them (55 min at 30 fps).
 MAX_GIF_BYTES = 512 << 20
 MAX_FRAMES = 100_000
 
@@ -112,7 +119,7 @@ def _output_kind(out: Path, raw: str) -> str:
     if raw.endswith(("/", os.sep)) or out.is_dir() or not out.suffix:
         return "frames"
     suffix = out.suffix.lower()
-    if suffix in (".gif", ".png"):
+    if suffix in (".gif", ".png", ".mp4"):
         return suffix[1:]
     raise ValueError(f"out must be {OUTPUT_KINDS}, got {raw!r}")
 
@@ -137,7 +144,7 @@ def frame_count(duration: float, fps: float, size: tuple[int, int], kind: str) -
     return frames
 
 
-def _check(duration: float, fps: float, size: tuple[int, int]) -> tuple[int, int]:
+def _check(duration: float, fps: float, size: tuple[int, int], kind: str = "gif") -> tuple[int, int]:
     if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
     if not (isinstance(fps, int | float) and math.isfinite(fps) and fps > 0):
@@ -148,7 +155,31 @@ def _check(duration: float, fps: float, size: tuple[int, int]) -> tuple[int, int
         raise ValueError(f"size must be (width, height) in pixels, got {size!r}") from None
     if width < 16 or height < 16 or width > 8192 or height > 8192:
         raise ValueError(f"size must be between 16 and 8192 pixels each way, got {size!r}")
+    if kind == "mp4" and (width % 2 or height % 2):
+        raise ValueError(f"an MP4's size must be even each way (H.264's 4:2:0 colour), got {width}x{height}")
     return width, height
+
+
+def _open_video(out: Path, kind: str, size: tuple[int, int], fps: float) -> Mp4Writer | None:
+    """The MP4 writer for ``out`` when ``kind`` is "mp4", else None."""
+    if kind != "mp4":
+        return None
+    from .mp4 import Mp4Writer
+
+    return Mp4Writer(out, size, fps)
+
+
+@contextmanager
+def _closing(video: Mp4Writer | None) -> Iterator[None]:
+    """Finish the video when the frames are done; drop the unfinished file when they are not."""
+    try:
+        yield
+    except BaseException:
+        if video is not None:
+            video.abort()
+        raise
+    if video is not None:
+        video.close()
 
 
 def render(
@@ -183,12 +214,12 @@ def render_world(
     raw = str(out)
     out = Path(out)
     kind = _output_kind(out, raw)
-    width, height = _check(duration, fps, size)
+    width, height = _check(duration, fps, size, kind)
     frames = frame_count(duration, fps, (width, height), kind)
     digits = max(4, len(str(frames - 1)))  # frame_0000.png ...: names sort in frame order
     if kind == "frames":
         out.mkdir(parents=True, exist_ok=True)
-    else:
+    elif kind != "mp4":  # an MP4's folder must exist, as simulate's outputs' do (the CLI says so)
         out.parent.mkdir(parents=True, exist_ok=True)
 
     sim = Simulation(world, scene_path, step_budget=math.inf)
@@ -198,7 +229,8 @@ def render_world(
     images: list[Image.Image] = []
     palette: Image.Image | None = None
     last: np.ndarray | None = None
-    with Offscreen((width, height), samples) as screen:
+    video = _open_video(out, kind, (width, height), fps)
+    with _closing(video), Offscreen((width, height), samples) as screen:
         bar = tqdm(
             range(frames), desc=f"rendering {look.name}", unit="frame", file=sys.stderr, disable=not progress
         )
@@ -216,6 +248,8 @@ def render_world(
                 if palette is None:
                     palette = gif_palette(last, look.sphere_colors)
                 images.append(Image.fromarray(last).quantize(palette=palette, dither=Image.Dither.NONE))
+            elif video is not None:
+                video.write(last)
     if kind == "gif":
         images[0].save(
             out,

@@ -5,14 +5,19 @@ current. Per frame the CPU work is whole-array NumPy plus a handful of GL calls:
 instance-buffer upload and one ``glDrawArraysInstanced`` whatever their number. Every draw goes through
 ``DrawLog`` so tests and benchmarks can see exactly which draw calls a frame made.
 
-Planes are drawn in two passes. Their front faces (the side the normal points to, where a scene puts
-its balls) are opaque and drawn first. Their back faces are the walls you look through, such as the
-near wall of a closed box seen from outside, so they are drawn see-through after the balls (blended,
-not writing depth). The second pass is skipped when the eye is on the front side of every plane.
+Planes are drawn in up to three passes. Their front faces (the side the normal points to, where a
+scene puts its balls) are opaque and drawn first. A solid plane (``solid_planes``: a finite floor or
+slope, one facing up when the scene starts) is opaque from behind too, in its own colour and lit as a
+face of its own, so a slope tilted over keeps its colour; those back faces are a second opaque pass.
+The back faces of the other planes are the walls you look through, such as the near wall of a closed
+box seen from outside, so they are drawn see-through after the balls (blended, not writing depth).
+The back passes are skipped when the eye is on the front side of every plane they would draw.
 
-The balls cast shadows onto the planes' front faces and darken them where they touch (see
+The balls cast shadows onto the planes' opaque faces and darken them where they touch (see
 shadows.py): each frame the balls are binned in a grid seen from the sun, uploaded as two texture
-buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call.
+buffers that the plane shader reads. That is NumPy work on the CPU and no extra draw call. The solid
+planes cast shadows on the other planes and on the balls (at most ``MAX_CASTERS``, passed as uniforms:
+casters.glsl), so a ball's shadow ends at the first plane under it.
 """
 
 from __future__ import annotations
@@ -34,7 +39,10 @@ FOG_DENSITY = 0.02  # 1/m: fog is light at 20 m, the ground faint by 60 m and go
 GROUND_EXTENT = 600.0  # half size (m) of the quad drawn for an infinite plane
 NO_EDGE = 1.0e6  # "half size" given to the shader for infinite planes: no edge band
 BALL_STRIDE = 12  # floats per instance: centre (3), radius, quaternion (4), colour (3), spare
-PLANE_STRIDE = 13  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3)
+PLANE_STRIDE = 14  # floats per plane vertex: position (3), local (2), half size (2), normal (3), colour (3),
+# solid (1)
+MAX_CASTERS = 16  # solid planes that cast shadows at most (plane.frag's MAX_CASTERS); the first ones
+SOLID_FACING = 0.5  # a finite plane whose normal's y is above this at the start is a floor or slope
 SORT_THRESHOLD = 256  # sort balls front to back above this many
 SHADOW_BALLS_UNIT, SHADOW_CELLS_UNIT = 1, 2  # texture units of the shadow grid's buffers
 _FLOAT = 4
@@ -74,6 +82,16 @@ def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     u, w = q[..., :3], q[..., 3:4]
     t = 2.0 * np.cross(u, v)
     return v + w * t + np.cross(u, t)
+
+
+def solid_planes(orientations: np.ndarray, half_sizes: np.ndarray) -> np.ndarray:
+    """Which planes are solid: finite and facing up (a floor or a slope, normal's y above
+    ``SOLID_FACING``). The others (walls, ceilings, the infinite ground) are seen through from behind,
+    so a closed box shows what is inside it, and they cast no shadow."""
+    q = np.asarray(orientations, dtype=float).reshape(-1, 4)
+    finite = np.isfinite(np.asarray(half_sizes, dtype=float).reshape(-1, 2)).all(axis=1)
+    up = rotate(q, np.broadcast_to([0.0, 1.0, 0.0], (len(q), 3)))[:, 1]
+    return finite & (up > SOLID_FACING)
 
 
 def _offset(floats: int) -> ctypes.c_void_p:
@@ -146,12 +164,15 @@ class Renderer:
         self.plane_vbo = GL.glGenBuffers(1)
         GL.glBindVertexArray(self.plane_vao)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
-        for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10)]):
+        for index, (size, offset) in enumerate([(3, 0), (2, 3), (2, 5), (3, 7), (3, 10), (1, 13)]):
             _attribute(index, size, PLANE_STRIDE, offset)
         self.plane_vertices = 0
         self.selected_plane = -1  # drawn with a highlighted rim (or tint, if infinite); -1: none
         self._plane_centers = np.zeros((0, 3))
         self._plane_normals = np.zeros((0, 3))
+        self._plane_solid = np.zeros(0, dtype=bool)
+        self._casters: dict[str, np.ndarray] = {}
+        self._caster_index = np.zeros(0, dtype=int)
 
         # ball shadows: the grid of balls seen from the sun, two texture buffers the plane shader reads
         self.shadows = True  # False: planes are drawn without ball shadows or contact darkening
@@ -175,9 +196,9 @@ class Renderer:
         self.plane_program.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
         GL.glUseProgram(0)
 
-        # debug lines: world lines (depth tested: trails) then overlay lines (always on top)
+        # trails (a triangle strip, depth tested) then overlay lines (always on top), in one buffer
         self.line_vao, self.line_vbo = _vertex_array()
-        self.world_line_vertices = 0
+        self.trail_vertices = 0
         self.overlay_line_vertices = 0
 
         # screen-space overlays in window pixels (timeline bar, energy plot): triangles, then lines
@@ -191,9 +212,12 @@ class Renderer:
 
     # ------------------------------------------------------------------ uploads
     def set_planes(
-        self, centers: np.ndarray, orientations: np.ndarray, half_sizes: np.ndarray, colors: np.ndarray
-    ) -> None:
-        """Build the plane quads: when the scene changes or a plane moved (a few planes: cheap)."""
+        self, centers: np.ndarray, orientations: np.ndarray, half_sizes: np.ndarray, colors: np.ndarray,
+        solid: np.ndarray | None = None,
+    ) -> None:  # fmt: skip
+        """Build the plane quads: when the scene changes or a plane moved (a few planes: cheap).
+        ``solid``: which planes are opaque from behind and cast shadows (default: ``solid_planes`` of
+        these poses; the window passes the scene's start, so a slope tilted over stays solid)."""
         centers = np.asarray(centers, dtype=float).reshape(-1, 3)
         count = len(centers)
         q = np.asarray(orientations, dtype=float).reshape(-1, 4)
@@ -204,6 +228,7 @@ class Renderer:
         u = rotate(q, np.broadcast_to([1.0, 0.0, 0.0], (count, 3)))
         n = rotate(q, np.broadcast_to([0.0, 1.0, 0.0], (count, 3)))
         v = rotate(q, np.broadcast_to([0.0, 0.0, 1.0], (count, 3)))
+        solid = solid_planes(q, half) if solid is None else np.asarray(solid, dtype=bool).reshape(count)
         # corners in plane-local units, two counter-clockwise triangles seen from the normal's side
         local = np.array([[-1, -1], [-1, 1], [1, 1], [-1, -1], [1, 1], [1, -1]], dtype=float)
         local = local[None] * drawn_half[:, None, :]  # (P, 6, 2)
@@ -214,11 +239,16 @@ class Renderer:
         data[..., 5:7] = shader_half[:, None, :]
         data[..., 7:10] = n[:, None, :]
         data[..., 10:13] = np.asarray(colors, dtype=float).reshape(-1, 3)[:, None, :]
+        data[..., 13] = solid[:, None]
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.plane_vbo)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
         self.plane_vertices = count * 6
-        self._plane_centers, self._plane_normals = centers, n
+        self._plane_centers, self._plane_normals, self._plane_solid = centers, n, solid
+        casts = np.flatnonzero(solid & ~infinite.any(axis=1))[:MAX_CASTERS]
+        self._casters = {"u_caster_center": centers[casts], "u_caster_u": u[casts], "u_caster_v": v[casts],
+                         "u_caster_half": half[casts], "u_caster_normal": n[casts]}  # fmt: skip
+        self._caster_index = casts
 
     def upload_balls(
         self,
@@ -299,10 +329,11 @@ class Renderer:
             GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
 
-    def upload_lines(self, world_lines: np.ndarray, overlay_lines: np.ndarray) -> None:
-        """Line vertices (M, 7) for this frame: depth-tested world lines, then always-visible overlays."""
-        data = np.concatenate([world_lines, overlay_lines]).astype(np.float32, copy=False)
-        self.world_line_vertices = len(world_lines)
+    def upload_lines(self, trails: np.ndarray, overlay_lines: np.ndarray) -> None:
+        """Vertices (M, 7) for this frame: the trails' triangle strip (depth-tested; overlays.py), then
+        the always-visible overlay lines."""
+        data = np.concatenate([trails, overlay_lines]).astype(np.float32, copy=False)
+        self.trail_vertices = len(trails)
         self.overlay_line_vertices = len(overlay_lines)
         if len(data):
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.line_vbo)
@@ -329,6 +360,16 @@ class Renderer:
         program.set("u_shadow_inverse_cell", 1.0 / grid.cell_size)
         program.set("u_shadow_shape", np.array(grid.shape, dtype=np.float32))
         program.set("u_shadow_reach", shadows.REACH)
+        self._caster_uniforms(program)
+
+    def _caster_uniforms(self, program: Program) -> None:
+        """The solid planes that cast shadows (casters.glsl), for the plane or the ball shader."""
+        casts = self._caster_index if self.shadows else np.zeros(0, dtype=int)
+        program.set_int("u_caster_count", len(casts))
+        if len(casts):
+            for name, values in self._casters.items():
+                program.set_array(name, values)
+            program.set_int_array("u_caster_index", casts)
         for unit, texture in ((SHADOW_BALLS_UNIT, self.shadow_textures[0]),
                               (SHADOW_CELLS_UNIT, self.shadow_textures[1])):  # fmt: skip
             GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
@@ -336,8 +377,26 @@ class Renderer:
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
     def seen_from_behind(self, eye: np.ndarray) -> np.ndarray:
-        """Which planes have the eye on their back side (drawn see-through), as a bool array."""
+        """Which planes have the eye on their back side, as a bool array."""
         return np.einsum("ij,ij->i", eye[None, :] - self._plane_centers, self._plane_normals) < 0.0
+
+    def _back_faces(self, label: str, solid: bool, view_projection: np.ndarray, eye: np.ndarray) -> None:
+        """The planes' back faces: the solid ones opaque, else the see-through ones blended."""
+        self._common_uniforms(self.plane_program, view_projection, eye)
+        self.plane_program.set("u_back_pass", 1.0 if solid else 0.0)
+        if solid:
+            self._shadow_uniforms(self.plane_program)
+        GL.glEnable(GL.GL_CULL_FACE)
+        GL.glCullFace(GL.GL_FRONT)
+        if not solid:
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
+            GL.glDepthMask(GL.GL_FALSE)
+        GL.glBindVertexArray(self.plane_vao)
+        self.draws.arrays(label, GL.GL_TRIANGLES, 0, self.plane_vertices)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glDisable(GL.GL_BLEND)
+        GL.glDisable(GL.GL_CULL_FACE)
 
     def draw(self, camera: Camera, width: int, height: int, multisample: bool = False) -> None:
         """Clear and draw the scene into the bound framebuffer's (0, 0, width, height) viewport."""
@@ -363,9 +422,13 @@ class Renderer:
             GL.glBindVertexArray(self.plane_vao)
             self.draws.arrays("planes", GL.GL_TRIANGLES, 0, self.plane_vertices)
             GL.glDisable(GL.GL_CULL_FACE)  # ball quads face the camera anyway
+        behind = self.seen_from_behind(camera.position) if self.plane_vertices else np.zeros(0, dtype=bool)
+        if (behind & self._plane_solid).any():
+            self._back_faces("solid plane backs", True, view_projection, eye)
 
         if self.ball_count:
             self._common_uniforms(self.ball_program, view_projection, eye)
+            self._caster_uniforms(self.ball_program)
             self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
             self.ball_program.set("u_alpha", 1.0)
             if multisample:
@@ -377,6 +440,7 @@ class Renderer:
 
         if self.ghost_count:  # translucent ghosts: blended, not writing depth
             self._common_uniforms(self.ball_program, view_projection, eye)
+            self._caster_uniforms(self.ball_program)
             self.ball_program.set("u_multisample", 1.0 if multisample else 0.0)
             self.ball_program.set("u_alpha", self.ghost_alpha)
             GL.glEnable(GL.GL_BLEND)
@@ -387,32 +451,22 @@ class Renderer:
             GL.glDepthMask(GL.GL_TRUE)
             GL.glDisable(GL.GL_BLEND)
 
-        if self.plane_vertices and self.seen_from_behind(camera.position).any():  # back faces, see-through
-            self._common_uniforms(self.plane_program, view_projection, eye)
-            GL.glEnable(GL.GL_CULL_FACE)
-            GL.glCullFace(GL.GL_FRONT)
-            GL.glEnable(GL.GL_BLEND)
-            GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
-            GL.glDepthMask(GL.GL_FALSE)
-            GL.glBindVertexArray(self.plane_vao)
-            self.draws.arrays("see-through planes", GL.GL_TRIANGLES, 0, self.plane_vertices)
-            GL.glDepthMask(GL.GL_TRUE)
-            GL.glDisable(GL.GL_BLEND)
-            GL.glDisable(GL.GL_CULL_FACE)
+        if (behind & ~self._plane_solid).any():  # back faces, see-through
+            self._back_faces("see-through planes", False, view_projection, eye)
 
-        if self.world_line_vertices or self.overlay_line_vertices:
+        if self.trail_vertices or self.overlay_line_vertices:
             self.line_program.use()
             self.line_program.set("u_view_projection", view_projection)
             GL.glEnable(GL.GL_BLEND)
             GL.glBlendFunc(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA)
             GL.glDepthMask(GL.GL_FALSE)
             GL.glBindVertexArray(self.line_vao)
-            if self.world_line_vertices:
-                self.draws.arrays("world lines", GL.GL_LINES, 0, self.world_line_vertices)
+            if self.trail_vertices:
+                self.draws.arrays("trails", GL.GL_TRIANGLE_STRIP, 0, self.trail_vertices)
             if self.overlay_line_vertices:
                 GL.glDisable(GL.GL_DEPTH_TEST)
                 self.draws.arrays(
-                    "overlay lines", GL.GL_LINES, self.world_line_vertices, self.overlay_line_vertices
+                    "overlay lines", GL.GL_LINES, self.trail_vertices, self.overlay_line_vertices
                 )
             GL.glDepthMask(GL.GL_TRUE)
 

@@ -1,5 +1,8 @@
 """Ctrl+S: the scene as it stands now (moved planes, added balls, every ball's state, the view) as a new
-TOML scene file beside the original, which loads back into the same World.
+TOML scene file beside the original, which loads back into the same World. A bundled scene lives inside
+the installed package (read-only, or lost on reinstall, or in a checkout's scenes/ where it would pass
+for a bundled scene): it is saved in the current directory, as is a scene in a folder that cannot be
+written to (``_folder_for``).
 
 The original file is edited with tomlkit, so its comments and layout stay wherever its values still
 hold: tables of planes that did not move and balls that did not change are left as written; a ball's

@@ -143,6 +143,25 @@ class Program:
             setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv, 4: GL.glUniform4fv}[arr.shape[-1]]
             setter(loc, 1, arr)
 
+    def set_array(self, uniform: str, values: np.ndarray) -> None:
+        """Set a uniform array of vec2 or vec3 from a (K, 2) or (K, 3) array."""
+        from OpenGL import GL
+
+        loc = self.location(uniform)
+        arr = np.ascontiguousarray(values, dtype=np.float32)
+        if loc >= 0 and len(arr):
+            setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv}[arr.shape[-1]]
+            setter(loc, len(arr), arr)
+
+    def set_int_array(self, uniform: str, values: np.ndarray) -> None:
+        """Set a uniform int array."""
+        from OpenGL import GL
+
+        loc = self.location(uniform)
+        arr = np.ascontiguousarray(values, dtype=np.int32)
+        if loc >= 0 and len(arr):
+            GL.glUniform1iv(loc, len(arr), arr)
+
     def set_int(self, uniform: str, value: int) -> None:
         """Set an int uniform, such as the texture unit a sampler reads (the program must be in use)."""
         from OpenGL import GL

@@ -10,6 +10,7 @@ import pytest
 
 import ballpit
 from ballpit.physics import step as pipeline
+from ballpit.physics.integrators import INTEGRATOR_NAMES
 from ballpit.physics.profile import StepProfile
 from ballpit.physics.settings import CONTACT_SLOP, MAX_INTERVALS
 
@@ -42,3 +43,46 @@ def test_a_step_lands_the_same_whatever_count_its_profile_starts_from(monkeypatc
     t1 = (v1 - 1.0) / G
     expected = 0.5 * v1 - G * (dt - t1)
     assert timed.spheres[0].velocity[1] == pytest.approx(expected, abs=1.5 * G * CONTACT_SLOP / v1)
+
+
+def turned(degrees: float) -> np.ndarray:
+    """A rotation by ``degrees`` about z after half as much about x."""
+    a, b = math.radians(degrees), math.radians(degrees / 2)
+    about_z = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+    about_x = np.array([[1, 0, 0], [0, math.cos(b), -math.sin(b)], [0, math.sin(b), math.cos(b)]])
+    return about_z @ about_x
+
+
+def turned_box(world: ballpit.World, turn: np.ndarray, restitution: float = 0.8) -> None:
+    """Six infinite walls facing in, |x|, |y|, |z| ≤ 1 in the frame ``turn`` takes to the world's."""
+    for face in (*np.eye(3), *-np.eye(3)):
+        world.add_plane(position=turn @ face, normal=-(turn @ face), restitution=restitution)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATOR_NAMES)
+@pytest.mark.parametrize("degrees", [0.0, 20.0, 45.0])
+def test_a_small_ball_pushed_out_of_a_big_one_beside_a_wall_does_not_fly_through_the_wall(
+    integrator, degrees
+):
+    """A 0.316 m, 100 kg ball touching the wall x = −1 and a 1 mm ball inside its shell, 5.7 cm deep
+    (a scene with overlap_tolerance = 0.06 may start so), moving at 10 m/s towards that wall. The
+    push-apart moves the small ball 5.5 cm, to the wall; the interval was planned from the gaps
+    measured before the move, so it flew on through the wall, 3 mm beyond it after step 0 and 42 mm
+    a step after that. Measured again after the move, it meets the wall and bounces: its centre stays
+    in the box, and it sinks into a wall by less than a tenth of its radius."""
+    turn = turned(degrees)
+    world = ballpit.World(integrator=integrator)
+    turned_box(world, turn)
+    big, small = 0.316, 0.001
+    world.add_sphere(position=turn @ np.array([-1 + big, 0, 0]), radius=big, mass=100.0)
+    world.add_sphere(
+        position=turn @ np.array([-1 + big - 0.26, 0, 0]),
+        radius=small,
+        velocity=turn @ np.array([-10.0, 0, 0]),
+    )
+    radii = world.spheres.radii
+    for _ in range(120):
+        world.step(1 / 240)
+        local = np.abs(world.spheres.positions @ turn).max(axis=1)
+        assert (local < 1.0).all()  # no centre beyond a wall
+        assert (local - (1.0 - radii) < 0.1 * radii).all()

@@ -39,13 +39,17 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         with prof.stage(Stage.CONTACT_ROWS):
             batch = rows.contact_rows(model, state, touching)
         with prof.stage(Stage.PENETRATION):
-            penetration.remove_penetration(model, state, touching, batch)
+            moved = penetration.remove_penetration(model, state, touching, batch)
+        if moved:  # the interval is planned from where the balls are now, not from where they overlapped
+            contacts, touching, batch, pairs = _measure_again(step, motion, pairs, free, remaining, touching)
         min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
         with prof.stage(Stage.IMPACTS):  # arrivals bounce in waves; then slower approaches stop
             impacts.in_waves(
                 model, state, touching, batch, step.restitution_threshold, min_normal_speed, step.events, now
             )
-            impacts.stop_approaches(model, state, touching, batch, min_normal_speed, step.events, now)
+            impacts.stop_approaches(
+                model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
+            )
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, forces)
         with prof.stage(Stage.RESTING_SOLVE):
@@ -68,7 +72,7 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again
         # for the rest of this step and the next ones (they replace the kept pairs).
         with prof.stage(Stage.PAIRS):
-            if (not first or push is not None) and pairs.escaped(model, state, lin, remaining):
+            if (not first or push is not None or moved) and pairs.escaped(model, state, lin, remaining):
                 ahead = remaining + (BROAD_PHASE_STEPS - 1) * dt
                 pairs = step.pairs.renew(model, state, remaining, ahead, lin, free, motion.awake)
                 contacts = narrowphase.contact_points(model, state, pairs)
@@ -81,6 +85,36 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         integrate_interval(step, forces, push, h)
         step.events.close_interval(h / remaining)
         elapsed = dt if h >= remaining else elapsed + h
+
+
+def _measure_again(
+    step: Step,
+    motion: Motion,
+    pairs: KeptPairs,
+    free: np.ndarray,
+    remaining: float,
+    touching: ContactPoints,
+) -> tuple[ContactPoints, ContactPoints, rows.ContactRows, KeptPairs]:
+    """After the push-apart moved balls: the kept pairs measured again (found again first if a ball was
+    moved out of the box they were found from), the ``touching`` contacts and their rows with the
+    pairs the move brought into contact added after them.
+
+    A ball pushed out of an overlap may now touch a wall it was far from (a small ball inside a big
+    one beside a wall is pushed to it): planned from the gaps measured before the move, the interval
+    would let it fly on through that wall. The contacts that touched before the move stay as they were
+    measured, so a move that brings nothing new into contact solves what it solved before."""
+    model, state, prof = step.model, step.state, step.profile
+    with prof.stage(Stage.PAIRS):
+        if pairs.escaped(model, state, free, remaining):
+            ahead = remaining + (BROAD_PHASE_STEPS - 1) * step.dt
+            pairs = step.pairs.renew(model, state, remaining, ahead, free, free, motion.awake)
+    contacts = measure(step, pairs)
+    met = (contacts.gap < step.touching) & ~np.isin(contacts.keys(), touching.keys())
+    if met.any():
+        touching = ContactPoints.concatenate([touching, contacts.subset(met)])
+    with prof.stage(Stage.CONTACT_ROWS):
+        batch = rows.contact_rows(model, state, touching)
+    return contacts, touching, batch, pairs
 
 
 def finish_conservatively(
