@@ -23,7 +23,7 @@ class Ends:
         else:  # the same compact numbering (balls in increasing order) from a table over the world
             present = np.zeros(rows_in_world, bool)
             present[ab] = True
-            self.balls = np.flatnonzero(present)
+            self.balls = present.nonzero()[0]
             self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
         self.share = np.bincount(self.ends, minlength=self.m).astype(float)

@@ -41,7 +41,7 @@ def advance(model: Model, state: State, h: float) -> None:
     """
     pl, pose = model.planes, state.planes
     velocity, spin = pl.velocity, model.plane_spin()
-    moving = np.flatnonzero(model.moving_plane_mask())
+    moving = (model.moving_plane_mask()).nonzero()[0]
     if moving.size == 0:
         return
     center, orientation = pose.center, pose.orientation

@@ -70,7 +70,7 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
         acc += k2
         acc *= sixth
         x += acc
-        if spun_up[part].any() or w.any() or not _keeps_orientation(q):
+        if np.count_nonzero(spun_up[part]) or np.count_nonzero(w) or not _keeps_orientation(q):
             # ω at the trial states: ang·½h + ω (stages 2 and 3) and ang·h + ω (stage 4)
             w_mid, w_end = omegas[:, :, :m]
             np.add(ang_half[part].T, w5, out=w_mid)
@@ -109,7 +109,7 @@ def _keeps_orientation(q: np.ndarray) -> bool:
     is q + (±0) = q, and so is the end q + acc·(h/6): adding a zero changes no finite value, except
     that −0 + +0 is +0. So q is kept when it is finite and holds no −0 (the identity holds +0s).
     """
-    return bool(np.isfinite(q).all()) and not (q.view(np.int64) == _NEGATIVE_ZERO).any()
+    return bool(np.isfinite(q).all()) and not np.count_nonzero(q.view(np.int64) == _NEGATIVE_ZERO)
 
 
 def _dq(q6: np.ndarray, w5: np.ndarray, out: np.ndarray, tmp: list[np.ndarray]) -> None:

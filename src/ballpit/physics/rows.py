@@ -20,6 +20,8 @@ from .contacts import SPHERE_PLANE, ContactPoints, take_indices
 from .model import Model
 from .state import State
 
+_ZERO = np.zeros(1)
+
 
 @dataclass
 class ContactRows:
@@ -62,21 +64,21 @@ class ContactRows:
         velocities ``v`` (row N the static world), against a moving plane's surface: the contact model's
         ``normal_speed`` on these rows."""
         surface = self.surface[idx].T if self.moving else None
-        v_a, v_b = np.take(v, self.a[idx], axis=0).T, np.take(v, self.b[idx], axis=0).T  # faster than v[a]
+        v_a, v_b = v.take(self.a[idx], axis=0).T, v.take(self.b[idx], axis=0).T  # faster than v[a]
         return contact_model.normal_speed(v_a, v_b, self.normal[idx].T, surface)
 
     def subset(self, mask: np.ndarray) -> ContactRows:
         """The contacts where ``mask`` holds."""
         kept = ("moving", "static")
         idx = take_indices(mask)
-        fields = {k: np.take(v, idx, axis=0) for k, v in vars(self).items() if k not in (*kept, "colours")}
+        fields = {k: v.take(idx, axis=0) for k, v in vars(self).items() if k not in (*kept, "colours")}
         return ContactRows(**fields, moving=self.moving, static=self.static)
 
 
 def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
     """Masses, lever arms, mixed materials and surface motion of the contacts ``c``, in colours."""
     sph, pl = model.spheres, model.planes
-    with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
+    with_static = lambda arr: np.concatenate((arr, _ZERO))  # noqa: E731 - row N is the static world
     radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
     if state.sleep.any:  # a sleeping ball an awake one leans on holds like a plane (sleeping.py)
         held = np.append(state.sleep.asleep, False)
@@ -170,7 +172,7 @@ def rows_at_end(
     on_plane = c.kind == SPHERE_PLANE
     spins = model.plane_spin()  # a plane too slow for its rate to be formed does not turn
     turning = spins.any(axis=1)
-    on = np.flatnonzero(on_plane & turning[np.where(on_plane, c.other, 0)])
+    on = (on_plane & turning[np.where(on_plane, c.other, 0)]).nonzero()[0]
     if on.size == 0:
         return rows
     plane, ball = c.other[on], c.a[on]

@@ -47,8 +47,8 @@ class _Colour:
         self.rolling = contacts.rolling[idx]
         self.surface = np.ascontiguousarray(contacts.surface[idx].T) if contacts.moving else None
         self.spin = np.ascontiguousarray(contacts.spin[idx].T) if contacts.moving else None
-        self.has_friction = bool(self.mu.any())
-        self.has_rolling = bool(self.rolling.any())
+        self.has_friction = bool(np.count_nonzero(self.mu))
+        self.has_rolling = bool(np.count_nonzero(self.rolling))
         # how a unit of friction's turn changes the relative spin (c = ρ_a/I_a − ρ_b/I_b), and a bound
         # on the surface speed a unit of rolling impulse changes (|ΔΩ|·ρ), for the convergence test
         self.lever = self.ra * self.iia - self.rb * self.iib
@@ -129,7 +129,7 @@ def _sweep_colour(
     """One colour's update, in Gauss–Seidel order within each contact: normal impulse, then friction,
     then rolling resistance (from the spin friction left). Returns a bound on the largest velocity
     change it made (m/s)."""
-    ga, gb = np.take(vw, c.a, axis=1), np.take(vw, c.b, axis=1)
+    ga, gb = vw.take(c.a, axis=1), vw.take(c.b, axis=1)
     va, wa, vb, wb = ga[:3], ga[3:], gb[:3], gb[3:]
     rel = model.contact_velocity(va, wa, vb, wb, c.n, c.ra, c.rb, c.surface)
     vn = exact.dot_cols(rel, c.n)
