@@ -84,7 +84,7 @@ class KeptPairs:
             # from the first only in the sign of a zero moves ``end`` by a signed zero at most, which
             # none of the comparisons below can tell apart.
             accel = accel[:1]
-        pad = radius + path.sag(np.linalg.norm(accel, axis=1), h)
+        pad = radius + path.sag(exact.norm_rows(accel), h)
         lift = path.path_offset(accel, h).T  # ½h²·b: the path's bend (0 if straight)
         shared = lift.shape[1] == 1
         size = min(n, ESCAPE_CHUNK)

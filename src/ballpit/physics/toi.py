@@ -133,7 +133,7 @@ def meetings(
                 pb[plane_k] = collision.closest_point_on_planes(
                     pa[plane_k], pk, pose.center, pose.axis_u, pose.axis_v, half
                 )
-        return np.linalg.norm(pa - pb, axis=1) - reach[k]
+        return exact.norm_rows(pa - pb) - reach[k]
 
     start = earliest(model, state, c, apart, x, v, acc, h, goal)
     return first_contact(gap_at, bound, h, goal, start=start), bound, apart
@@ -197,8 +197,8 @@ def threatened(model: Model, state: State, c: ContactPoints, accel: np.ndarray, 
     apart = (c.gap >= model.contact_slop()).nonzero()[0]
     if apart.size:
         body, path = state.body, model.integrator
-        speed = np.append(np.linalg.norm(body[:, V], axis=1), 0.0)
-        acc = np.append(np.linalg.norm(path.path_acceleration(accel), axis=1), 0.0)
+        speed = np.append(exact.norm_rows(body[:, V]), 0.0)
+        acc = np.append(exact.norm_rows(path.path_acceleration(accel)), 0.0)
         a, b = c.a[apart], c.b[apart]
         bound = speed[a] + speed[b] + (acc[a] + acc[b]) * h
         if model.moving_planes():
