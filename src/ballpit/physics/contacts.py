@@ -165,6 +165,9 @@ class EventLog:
     def record(self) -> ContactRecord:
         if not self._parts:
             return ContactRecord.empty()
+        if len(self._parts) == 1:  # one add: one entry per pair already, in order, at one time
+            time, c, _, impulse = self._parts[0]
+            return ContactRecord(time, c.kind.astype(np.int8), c.a, c.other, c.point, c.normal, impulse)
         time = np.concatenate([p[0] for p in self._parts])
         keys = np.concatenate([p[2] for p in self._parts])
         impulse = np.concatenate([p[3] for p in self._parts])
