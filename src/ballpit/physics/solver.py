@@ -22,6 +22,9 @@ from .rows import ContactRows
 from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 
 
+_SIX = np.arange(6)
+
+
 class _Colour:
     """One colour's contacts, gathered once per solve so the sweeps only touch velocities.
 
@@ -64,16 +67,20 @@ def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulse
     linear = imp.normal * n + friction
     turn = model.turn(n, friction)
     ra, rb = contacts.arm_lengths()
-    rows = len(v)
+    rows, k = len(v), len(contacts)
+    change = np.empty((k, 6))  # each contact's [Δv Δω] on one of its bodies, a row each
     for body, sign, im, ii, r in (
         (contacts.a, 1.0, contacts.inv_mass_a, contacts.inv_inertia_a, ra),
         (contacts.b, -1.0, contacts.inv_mass_b, contacts.inv_inertia_b, rb),
     ):
-        dv = sign * linear * im
-        dw = (-r * turn + sign * rolling) * ii
-        for axis in range(3):
-            v[:, axis] += np.bincount(body, dv[axis], minlength=rows)
-            w[:, axis] += np.bincount(body, dw[axis], minlength=rows)
+        change[:, :3] = (sign * linear * im).T
+        change[:, 3:] = ((-r * turn + sign * rolling) * ii).T
+        # one bincount for all six columns (bin 6·ball + column): each bin sums its contacts in their
+        # order from zero, as a bincount per column does
+        bins = (body[:, None] * 6 + _SIX).ravel()
+        sums = np.bincount(bins, change.ravel(), minlength=6 * rows).reshape(rows, 6)
+        v += sums[:, :3]
+        w += sums[:, 3:]
     v[-1] = 0.0
     w[-1] = 0.0
 
