@@ -21,7 +21,6 @@ from .ends import Ends
 from .rows import ContactRows
 from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 
-
 _SIX = np.arange(6)
 
 
