@@ -18,6 +18,7 @@ from . import contact_model, exact, moving_planes
 from .contact_model import Impulses
 from .contacts import SPHERE_PLANE, ContactPoints, take_indices
 from .model import Model
+from .settings import ONE_COLOUR_CHECK_UP_TO
 from .state import State
 
 _ZERO = np.zeros(1)
@@ -130,6 +131,11 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
     (Luby's independent sets); priorities are a fixed hash of the index, so colouring is deterministic.
     """
     remaining = np.arange(len(a))
+    if 0 < len(a) <= ONE_COLOUR_CHECK_UP_TO:  # a few contacts on different balls: one colour
+        ends = np.concatenate((a, b[b != static]))
+        ends.sort()
+        if not np.count_nonzero(ends[1:] == ends[:-1]):
+            return [remaining]
     priority = (remaining.astype(np.uint64) * np.uint64(2654435761)) % np.uint64(4294967291)
     order = np.argsort(priority, kind="stable")
     rank = np.empty(len(a), np.int64)
