@@ -79,7 +79,7 @@ class KeptPairs:
             self._columns = tuple(np.ascontiguousarray(a.T) for a in (self.lo, self.hi, self.centre))
         lo, hi, centre = self._columns
         n = len(body)
-        if n and (accel == accel[0]).all():
+        if n and not np.count_nonzero(accel != accel[0]):
             # One acceleration for all (gravity, drag-free flight): a single column. A row that differs
             # from the first only in the sign of a zero moves ``end`` by a signed zero at most, which
             # none of the comparisons below can tell apart.
@@ -102,11 +102,11 @@ class KeptPairs:
             # the box around the chord, grown by pad, inside the kept box
             np.minimum(xs, ends, out=ds)
             ds -= pads
-            if np.any(ds < lo[:, rows]):
+            if np.count_nonzero(ds < lo[:, rows]):
                 return True
             np.maximum(xs, ends, out=ds)
             ds += pads
-            if np.any(ds > hi[:, rows]):
+            if np.count_nonzero(ds > hi[:, rows]):
                 return True
             # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
             np.subtract(xs, centre[:, rows], out=ds)
@@ -115,7 +115,7 @@ class KeptPairs:
             exact.norm_cols(ds, es, tmps)
             np.maximum(fars, tmps, out=fars)
             fars += pads
-            if np.any(fars > self.reach[rows]):
+            if np.count_nonzero(fars > self.reach[rows]):
                 return True
         return False
 

@@ -25,7 +25,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
     whether any ball moved."""
     radius = model.spheres.radius
     tolerance = min(PENETRATION_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
-    if not np.any(c.gap < -tolerance):
+    if not np.count_nonzero(c.gap < -tolerance):
         return False
     x = state.body[:, X]
     pos = with_static(x)
@@ -36,7 +36,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         _separate_by_colour(c, rows, pos)
     new = keep_sides_of_planes(model, state, x, pos[:-1], deeper=True)
     energy_guard.pay_for_lift(model, state, x, new, partly=True)
-    moved = bool((new != x).any())
+    moved = bool(np.count_nonzero(new != x))
     x[:] = new
     return moved
 
@@ -128,7 +128,7 @@ def keep_sides_of_planes(
         # ones (it was out of reach before the move), and the ball would fly on into it
         floor = np.minimum(radius, np.abs(d0)) - HOLD_SINK * radius
         into = ~crossing & (np.where(d0 >= 0.0, d1, -d1) < floor) & deeper
-        if not (crossing.any() or into.any()):
+        if not (np.count_nonzero(crossing) or np.count_nonzero(into)):
             continue
         k = (crossing | into).nonzero()[0]
         # where the centre crosses, or ends

@@ -110,7 +110,7 @@ def _measure_again(
             pairs = step.pairs.renew(model, state, remaining, ahead, free, free, motion.awake)
     contacts = measure(step, pairs)
     met = (contacts.gap < step.touching) & ~np.isin(contacts.keys(), touching.keys())
-    if met.any():
+    if np.count_nonzero(met):
         touching = ContactPoints.concatenate([touching, contacts.subset(met)])
     with prof.stage(Stage.CONTACT_ROWS):
         batch = rows.contact_rows(model, state, touching)
