@@ -184,7 +184,7 @@ def rows_at_end(
     plane, ball = c.other[on], c.a[on]
     spin = spins[plane]
     rates = [exact.norm_floats(x, y, z) for x, y, z in spins.tolist()]
-    sin_all, cos_all = exact.sin_cos(np.array(rates) * h)  # not math's: its bits depend on the CPU
+    sin_all, cos_all = _sin_cos(np.array(rates) * h)
     sin, cos = sin_all[plane, None], cos_all[plane, None]
     axis = spin / np.array(rates)[plane, None]
     n = rows.normal[on]
@@ -205,3 +205,22 @@ def rows_at_end(
     if "colours" in rows.__dict__:  # the same contacts: the same colours
         end.__dict__["colours"] = rows.colours
     return end
+
+
+# The planes' sines and cosines by their angles' bits: planes turning steadily turn by the same angles
+# every whole step, so they are worked out once (as moving_planes keeps its turns).
+_SIN_COS: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+_SIN_COS_KEPT = 256
+
+
+def _sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``exact.sin_cos`` of a few planes' angles (not math's: its bits depend on the CPU), remembered."""
+    key = angle.tobytes()
+    found = _SIN_COS.get(key)
+    if found is None:
+        if len(_SIN_COS) >= _SIN_COS_KEPT:
+            _SIN_COS.clear()
+        sin, cos = exact.sin_cos(angle)
+        sin.flags.writeable = cos.flags.writeable = False
+        found = _SIN_COS[key] = (sin, cos)
+    return found
