@@ -9,7 +9,7 @@ zero inverse mass (docs/architecture.md, "Conventions").
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -19,7 +19,7 @@ from .contact_model import Impulses
 from .contacts import SPHERE_PLANE, ContactPoints, take_indices
 from .model import Model
 from .settings import ONE_COLOUR_CHECK_UP_TO
-from .state import State
+from .state import State, shallow_copy
 
 _ZERO = np.zeros(1)
 
@@ -201,9 +201,8 @@ def rows_at_end(
     surface[on] = pl.velocity[plane] + exact.cross_rows(spin, centre - radius * turned - plane_centre)
     friction = warm.friction[on]
     warm.friction[on] = friction - exact.dot_rows(friction, turned)[:, None] * turned
-    end = replace(rows, normal=normal, surface=surface)  # the lever arms turn with the normal
-    if "colours" in rows.__dict__:  # the same contacts: the same colours
-        end.__dict__["colours"] = rows.colours
+    end = shallow_copy(rows)  # the same contacts (and colours, if found), their normals and surfaces
+    end.normal, end.surface = normal, surface  # turned; the lever arms turn with the normal
     return end
 
 
