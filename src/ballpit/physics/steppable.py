@@ -221,8 +221,8 @@ def _bad_plane_values(kind: str, arr: np.ndarray, limit: float | None) -> np.nda
 def plane_columns(shape, pose) -> list[np.ndarray]:
     """The live plane columns ``reject_bad_planes`` checks (``shape``/``pose``: the model's and the
     state's plane Columns), in its order."""
-    n = shape.count  # every step looks: full(name)[:n] costs a third of Columns.__getattr__
-    return [(pose if where == "pose" else shape).full(name)[:n] for name, where, _, _ in _PLANE_FIELDS]
+    # every step looks: each column's live rows are a plain attribute (``Columns._publish``)
+    return [getattr(pose if where == "pose" else shape, name) for name, where, _, _ in _PLANE_FIELDS]
 
 
 class PlanesAsStepped:
