@@ -14,12 +14,14 @@ from functools import cached_property
 
 import numpy as np
 
-from . import contact_model, exact, moving_planes
+from ..core import exact
+from ..core.contacts import SPHERE_PLANE, ContactPoints, take_indices
+from ..core.settings import ONE_COLOUR_CHECK_UP_TO
+from ..core.state import State, shallow_copy
+from ..dynamics import moving_planes
+from ..dynamics.model import Model
+from . import contact_model
 from .contact_model import Impulses
-from .contacts import SPHERE_PLANE, ContactPoints, take_indices
-from .model import Model
-from .settings import ONE_COLOUR_CHECK_UP_TO
-from .state import State, shallow_copy
 
 _ZERO = np.zeros(1)
 
