@@ -53,9 +53,18 @@ class ContactRows:
 
     def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side, as the lengths
-        of the lever arms −radius_a·n and radius_b·n (formed here and dropped: (K, 3) each)."""
-        n = self.normal[idx]
-        return exact.norm_rows(-self.radius_a[idx, None] * n), exact.norm_rows(self.radius_b[idx, None] * n)
+        of the lever arms −radius_a·n and radius_b·n (read only)."""
+        a, b = self._arms
+        return a[idx], b[idx]
+
+    @cached_property
+    def _arms(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every contact's |r_a| and |r_b|, formed once (the solves ask for them several times an
+        interval; each row's length is the same whichever rows are asked for)."""
+        n = self.normal
+        a, b = exact.norm_rows(-self.radius_a[:, None] * n), exact.norm_rows(self.radius_b[:, None] * n)
+        a.flags.writeable = b.flags.writeable = False
+        return a, b
 
     @cached_property
     def colours(self) -> list[np.ndarray]:
@@ -74,7 +83,8 @@ class ContactRows:
         """The contacts where ``mask`` holds."""
         kept = ("moving", "static")
         idx = take_indices(mask)
-        fields = {k: v.take(idx, axis=0) for k, v in vars(self).items() if k not in (*kept, "colours")}
+        found = (*kept, "colours", "_arms")  # worked out from the rows, not rows themselves
+        fields = {k: v.take(idx, axis=0) for k, v in vars(self).items() if k not in found}
         return ContactRows(**fields, moving=self.moving, static=self.static)
 
 
@@ -205,6 +215,7 @@ def rows_at_end(
     warm.friction[on] = friction - exact.dot_rows(friction, turned)[:, None] * turned
     end = shallow_copy(rows)  # the same contacts (and colours, if found), their normals and surfaces
     end.normal, end.surface = normal, surface  # turned; the lever arms turn with the normal
+    end.__dict__.pop("_arms", None)
     return end
 
 
