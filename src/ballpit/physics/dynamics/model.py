@@ -156,8 +156,12 @@ class Model:
     def contact_slop(self) -> float:
         """The gap (m) under which a pair is touching in this world, for every stage of the step:
         CONTACT_SLOP, or SLOP_PER_RADIUS of the smallest ball's radius if that is less."""
-        radius = self.spheres.radius
-        return min(CONTACT_SLOP, SLOP_PER_RADIUS * float(radius.min())) if len(radius) else CONTACT_SLOP
+        radius = self.spheres.radius  # (the smallest by the ufunc's reduce, without ndarray.min's wrapper)
+        return (
+            min(CONTACT_SLOP, SLOP_PER_RADIUS * float(np.minimum.reduce(radius)))
+            if len(radius)
+            else CONTACT_SLOP
+        )
 
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""
@@ -177,4 +181,5 @@ class Model:
         """
         if self.restitution_threshold is not None:
             return self.restitution_threshold
-        return self.integrator.threshold_steps * float(exact.norm_rows(self.gravity)) * dt
+        # |g| in Python floats: the same squares summed in the same order, correctly rounded alike
+        return self.integrator.threshold_steps * exact.norm_floats(*self.gravity.tolist()) * dt
