@@ -69,7 +69,7 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
         empty = np.zeros(0, np.intp)
         return empty, empty
     if n <= ALL_PAIRS_UP_TO:  # a handful of balls: every pair in one go, already in order
-        i, j = np.triu_indices(n, 1)
+        i, j = _every_pair(n)
         hit = _overlap(lo, hi, i, j)
         return i[hit], j[hit]
     # the largest side of each box, axis by axis on columns (a max is exact, in any order)
@@ -113,6 +113,20 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     key.sort()
     first = key // n
     return first.astype(np.intp), (key - first * n).astype(np.intp)
+
+
+# Every pair (i < j) of n boxes, by n (np.triu_indices, read only): made once for each small n.
+_EVERY_PAIR: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _every_pair(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(n, 1)``, kept (it costs a dozen NumPy calls, more than the test it feeds)."""
+    pairs = _EVERY_PAIR.get(n)
+    if pairs is None:
+        i, j = np.triu_indices(n, 1)
+        i.flags.writeable = j.flags.writeable = False
+        pairs = _EVERY_PAIR[n] = (i, j)
+    return pairs
 
 
 def _neighbour_steps(dims: np.ndarray) -> np.ndarray:

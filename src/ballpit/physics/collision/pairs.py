@@ -84,8 +84,8 @@ class KeptPairs:
         lift = path.path_offset(accel, h).T  # ½h²·b: the path's bend (0 if straight)
         shared = lift.shape[1] == 1
         size = min(n, ESCAPE_CHUNK)
-        x, end, d, e = (np.empty((3, size)) for _ in range(4))
-        far, tmp = np.empty(size), np.empty(size)
+        x, end, d, e = np.empty((4, 3, size))  # scratch, one allocation
+        far, tmp = np.empty((2, size))
         for start in range(0, n, ESCAPE_CHUNK):
             rows = slice(start, start + ESCAPE_CHUNK)
             m = min(ESCAPE_CHUNK, n - start)
