@@ -23,6 +23,7 @@ from .ends import Ends
 from .rows import ContactRows
 
 _SIX = np.arange(6)
+# (Maxima here are np.maximum.reduce: ndarray.max's Python wrapper costs more than a few contacts' max.)
 
 
 class _Colour:
@@ -45,7 +46,10 @@ class _Colour:
         # what a unit of tangential impulse turns each ball by (Δω = −ρ·I⁻¹·(n × P_t))
         self.turn_a, self.turn_b = -(self.ra * self.iia), -(self.rb * self.iib)
         # bounds on how much a unit of impulse changes a contact's velocity, for the convergence test
-        self.max_inv_m_n, self.max_inv_m_t = float(inverse[0].max()), float(inverse[1].max())
+        self.max_inv_m_n, self.max_inv_m_t = (
+            float(np.maximum.reduce(inverse[0])),
+            float(np.maximum.reduce(inverse[1])),
+        )
         self.mu = contacts.friction[idx]
         self.rolling = contacts.rolling[idx]
         self.surface = np.ascontiguousarray(contacts.surface[idx].T) if contacts.moving else None
@@ -55,7 +59,7 @@ class _Colour:
         # how a unit of friction's turn changes the relative spin (c = ρ_a/I_a − ρ_b/I_b), and a bound
         # on the surface speed a unit of rolling impulse changes (|ΔΩ|·ρ), for the convergence test
         self.lever = self.ra * self.iia - self.rb * self.iib
-        self.max_roll = float((self.iia * self.ra + self.iib * self.rb).max())
+        self.max_roll = float(np.maximum.reduce(self.iia * self.ra + self.iib * self.rb))
 
 
 def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -107,7 +111,7 @@ def solve(
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
     ends = Ends(contacts.a, contacts.b)
-    vw = np.ascontiguousarray(np.hstack((v[ends.balls], w[ends.balls])).T)  # (6, M)
+    vw = np.ascontiguousarray(np.concatenate((v[ends.balls], w[ends.balls]), axis=1).T)  # (6, M)
     colours = [_Colour(contacts, idx, ends.ends) for idx in contacts.colours]
     targets = [target[c.idx] for c in colours]
     normal = [imp.normal[c.idx] for c in colours]
@@ -146,7 +150,7 @@ def _sweep_colour(
     normal[k] = new
     d_n = new - old
     linear = d_n * c.n
-    change = float(np.abs(d_n).max()) * c.max_inv_m_n
+    change = float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
 
     if c.has_friction and c.has_rolling:
         # friction and rolling resistance together: where both stay within their limits the block
@@ -171,7 +175,11 @@ def _sweep_colour(
         turn = model.turn(c.n, d_t)
         wa += c.turn_a * turn + c.iia * d_r
         wb += c.turn_b * turn - c.iib * d_r
-        change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t, float(np.abs(d_r).max()) * c.max_roll)
+        change = max(
+            change,
+            float(np.maximum.reduce(np.abs(d_t), axis=None)) * c.max_inv_m_t,
+            float(np.maximum.reduce(np.abs(d_r), axis=None)) * c.max_roll,
+        )
     elif c.has_friction:
         # friction cancels slip (the tangential part of rel, which the normal impulse leaves alone)
         old_t = friction[k]
@@ -182,7 +190,7 @@ def _sweep_colour(
         turn = model.turn(c.n, d_t)
         wa += c.turn_a * turn
         wb += c.turn_b * turn
-        change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t)
+        change = max(change, float(np.maximum.reduce(np.abs(d_t), axis=None)) * c.max_inv_m_t)
     elif c.has_rolling:
         # rolling resistance opposes relative spin, up to ρ_roll·P_n
         old_r = rolling[k]
@@ -192,7 +200,7 @@ def _sweep_colour(
         d_r = new_r - old_r
         wa += c.iia * d_r
         wb -= c.iib * d_r
-        change = max(change, float(np.abs(d_r).max()) * c.max_roll)
+        change = max(change, float(np.maximum.reduce(np.abs(d_r), axis=None)) * c.max_roll)
 
     va += c.ima * linear
     vb -= c.imb * linear
