@@ -176,8 +176,8 @@ class EventLog:
         return ContactRecord(
             time=time[first],
             kind=c.kind[first].astype(np.int8),
-            a=c.a[first],
-            b=c.other[first],
+            a=c.a[first].astype(np.intp),
+            b=c.other[first].astype(np.intp),
             point=c.point[first],
             normal=c.normal[first],
             impulse=total[order],

@@ -207,15 +207,17 @@ def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, ad
     g, n = model.gravity, f.n
     level = np.abs(exact.dot_cols(g, n)) <= LEVEL * exact.norm_rows(g)
     kept = np.where((added != 0.0) & level, np.minimum(f.normal, f.came_with), f.normal)
-    warm.keep(f.keys, Impulses(kept, f.tangential[0].T.copy(), f.tangential[1].T.copy()), f.h)
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T
     body[idx, W] = f.vw[3:, live].T
     body[idx, Q] = f.q
-    # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now
+    # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now,
+    # before the warm start makes its own sorted copies of the impulses
     f.whole = f.k.whole
+    tangential = f.tangential
     f.k = f.vw = f.q = f.tangential = f.came_with = f.vn_start = None
+    warm.keep(f.keys, Impulses(kept, tangential[0].T, tangential[1].T), f.h)
 
 
 def _soft_sweeps(
