@@ -90,7 +90,8 @@ class ContactColumns(Ends):
         vn = np.empty(k)  # SWEEP_CHUNK contacts at a time: the gathers of a chunk, not of all
         for lo in range(0, k, SWEEP_CHUNK):
             part = slice(lo, min(lo + SWEEP_CHUNK, k))
-            v_a, v_b = np.take(v[:3], self.ends[:k][part], axis=1), np.take(v[:3], self.ends[k:][part], axis=1)
+            v_a = np.take(v[:3], self.ends[:k][part], axis=1)
+            v_b = np.take(v[:3], self.ends[k:][part], axis=1)
             surface = None if self.surface is None else self.surface[:, part]
             vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface)
         return vn
