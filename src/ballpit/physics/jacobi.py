@@ -98,29 +98,41 @@ class ContactColumns(Ends):
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
-        each): the effective masses ``m_n`` and ``m_tr`` (friction, then rolling, as (2, 1, K)), formed
-        SWEEP_CHUNK contacts at a time into the arrays of the last split (a soft frame splits once a
-        substep)."""
+        each): each ball's ``shares`` and the normal effective masses ``m_n``, formed SWEEP_CHUNK
+        contacts at a time into the array of the last split (a soft frame splits once a substep). The
+        friction and rolling ones are formed where a full sweep uses them (``tangent_masses``)."""
         k = self.k
         if pushing is None:
             share = self.share
         else:
             counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
             share = np.maximum(counts, 1.0)
+        self.shares = share
         if self.m_n is None:
-            self.m_n, self.m_tr = np.empty(k), np.empty((2, 1, k))
+            self.m_n = np.empty(k)
         for lo in range(0, k, SWEEP_CHUNK):
             part = slice(lo, min(lo + SWEEP_CHUNK, k))
             sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
-            m_n, m_t, m_r = model.effective_masses(
-                sa * self.ima[part],
-                sb * self.imb[part],
-                sa * self.iia[part],
-                sb * self.iib[part],
-                self.ra[part],
-                self.rb[part],
-            )
-            self.m_n[part], self.m_tr[0, 0, part], self.m_tr[1, 0, part] = m_n, m_t, m_r
+            # model.effective_masses' m_n: 1/(n_a·m_a⁻¹ + n_b·m_b⁻¹)
+            inv_n = sa * self.ima[part]
+            inv_n += sb * self.imb[part]
+            np.divide(1.0, inv_n, out=self.m_n[part])
+
+    def tangent_masses(self, part: slice) -> np.ndarray:
+        """The friction and rolling effective masses m_t, m_r of the contacts ``part`` as (2, 1, chunk),
+        with the masses split as the last ``split`` split them (``model.effective_masses``)."""
+        k, share = self.k, self.shares
+        sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
+        m_t_r = np.empty((2, 1, len(sa)))
+        _, m_t_r[0, 0], m_t_r[1, 0] = model.effective_masses(
+            sa * self.ima[part],
+            sb * self.imb[part],
+            sa * self.iia[part],
+            sb * self.iib[part],
+            self.ra[part],
+            self.rb[part],
+        )
+        return m_t_r
 
 
 def solve(
@@ -358,7 +370,7 @@ def _full_chunk(
         spin -= c.spin[:, part]
     # the new impulses are formed in the slip's scratch, the change in the old impulses' block
     candidate = motion[:, :, part]
-    candidate *= c.m_tr[:, :, part]
+    candidate *= c.tangent_masses(part)
     before = tangential[:, :, part]
     np.subtract(before, candidate, out=candidate)
     limits = np.empty((2, len(vn)))

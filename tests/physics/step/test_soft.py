@@ -28,7 +28,7 @@ def judged_always(monkeypatch, verdict: soft.Verdict) -> list[int]:
     """Every try judged ``verdict``; returns the list each try is counted in."""
     tries = []
 
-    def judge(step, motion, gaps, solved, c, frame, before):
+    def judge(step, motion, left, c, frame, before):
         tries.append(frame)
         return verdict
 

@@ -114,10 +114,19 @@ def _try(
     overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    body_before = checkpoint.state.body  # the balls as the frame found them
     frame = softstep.frame(
-        model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps, step.profile
+        model,
+        state,
+        c,
+        motion.forces,
+        dt,
+        step.restitution_threshold,
+        step.warm,
+        substeps,
+        step.profile,
+        lambda: checkpoint.keep_balls(step.parts),
     )
+    body_before = checkpoint.state.body  # the balls as the frame found them
     balls = frame.balls[frame.balls < n]
     others = np.ones(n, bool)
     others[balls] = False
