@@ -235,20 +235,24 @@ def _apply_by_rows(
     """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
     ball, are those of the (6, 2K) block."""
     k, n = c.k, c.n
-    total = np.empty((6, c.m))
     at_a, at_b = row[:k], row[k:]
     for r in range(3):  # Δv: ±(P_n·n + P_t)
         np.multiply(normal, n[r], out=at_a)
         at_a += d_t[r]
         np.negative(at_a, out=at_b)
-        total[r] = c.add_row(row)
+        _add_row(c, vw[r], row, c.inverse[0])
     for r in range(3):  # Δω: −ρ·(n × P_t) ± R
         exact.cross_col(n, d_t, r, out=at_b)
         _turns(at_b, at_a, c.ra, c.rb, d_r[r])
-        total[3 + r] = c.add_row(row)
-    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
-    by_kind *= c.inverse[:, None, :]
-    vw += total
+        _add_row(c, vw[3 + r], row, c.inverse[1])
+
+
+def _add_row(c: ContactColumns, into: np.ndarray, row: np.ndarray, inverse: np.ndarray) -> None:
+    """Add one row of pushes per contact end, summed per ball and times each ball's m⁻¹ or I⁻¹, to
+    ``into``: a row of the (rows, M) sums at a time, not the whole block."""
+    summed = c.add_row(row)
+    summed *= inverse
+    into += summed
 
 
 def _turns(turn: np.ndarray, at_a: np.ndarray, ra: np.ndarray, rb: np.ndarray, d_r: np.ndarray) -> None:
@@ -275,19 +279,19 @@ def _normal_sweep(
     k, n = c.k, c.n
     vn = c.normal_speeds(vw)
     new = model.normal_impulse(normal, m_n, target, vn, give)
-    d_n = new - normal
+    d_n = np.subtract(new, normal, out=vn)  # in v_n's array, used up
+    del vn
     if len(push) == 1:  # one row at a time (``apply``)
-        total = np.empty((3, c.m))
         row = push[0]
         for r in range(3):
             np.multiply(d_n, n[r], out=row[:k])
             np.negative(row[:k], out=row[k:])
-            total[r] = c.add_row(row)
-    else:
-        lin = push[:3]
-        np.multiply(d_n, n, out=lin[:, :k])
-        np.negative(lin[:, :k], out=lin[:, k:])
-        total = c.add_up(lin)
+            _add_row(c, vw[r], row, c.inverse[0])
+        return new
+    lin = push[:3]
+    np.multiply(d_n, n, out=lin[:, :k])
+    np.negative(lin[:, :k], out=lin[:, k:])
+    total = c.add_up(lin)
     total *= c.inverse[0]
     vw[:3] += total
     return new
