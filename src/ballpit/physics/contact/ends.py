@@ -24,8 +24,7 @@ class Ends:
             present = np.zeros(rows_in_world, bool)
             present[ab] = True
             self.balls = np.flatnonzero(present)
-            # counted in the contacts' own index type (int32 while the rows fit): 8 bytes a contact
-            self.ends = np.take(np.cumsum(present, dtype=ab.dtype) - 1, ab)
+            self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
         self.share = np.bincount(self.ends, minlength=self.m).astype(float)
         self._flat: dict[int, np.ndarray] = {}  # add_up's bins for every entry, by number of rows

@@ -77,6 +77,7 @@ class ContactColumns(Ends):
         self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
         self.motion = np.empty((2, 3, k))
         self.m_n: np.ndarray | None = None
+        self.m_tr: np.ndarray | None = None
         self.split()
 
     def normal_speeds(self, v: np.ndarray) -> np.ndarray:
@@ -98,9 +99,10 @@ class ContactColumns(Ends):
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
-        each): each ball's ``shares`` and the normal effective masses ``m_n``, formed SWEEP_CHUNK
-        contacts at a time into the array of the last split (a soft frame splits once a substep). The
-        friction and rolling ones are formed where a full sweep uses them (``tangent_masses``)."""
+        each): each ball's ``shares`` and the effective masses ``m_n`` and ``m_tr`` (friction, then
+        rolling, as (2, 1, K)). Beyond SWEEP_CHUNK contacts, ``m_n`` is formed a chunk at a time into
+        the array of the last split (a soft frame splits once a substep) and m_t, m_r where a full
+        sweep's chunk uses them (``tangent_masses``): not kept, 16 bytes a contact."""
         k = self.k
         if pushing is None:
             share = self.share
@@ -108,6 +110,13 @@ class ContactColumns(Ends):
             counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
             share = np.maximum(counts, 1.0)
         self.shares = share
+        if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept
+            sa, sb = share[self.ends[:k]], share[self.ends[k:]]
+            self.m_n, m_t, m_r = model.effective_masses(
+                sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
+            )
+            self.m_tr = np.stack((m_t, m_r))[:, None, :]
+            return
         if self.m_n is None:
             self.m_n = np.empty(k)
         for lo in range(0, k, SWEEP_CHUNK):
@@ -121,6 +130,8 @@ class ContactColumns(Ends):
     def tangent_masses(self, part: slice) -> np.ndarray:
         """The friction and rolling effective masses m_t, m_r of the contacts ``part`` as (2, 1, chunk),
         with the masses split as the last ``split`` split them (``model.effective_masses``)."""
+        if self.k <= SWEEP_CHUNK:
+            return self.m_tr
         k, share = self.k, self.shares
         sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
         m_t_r = np.empty((2, 1, len(sa)))
