@@ -277,3 +277,18 @@ def test_a_pair_touches_within_ten_micrometres_or_a_thousandth_of_the_smallest_r
     assert world.model.contact_slop() == 1e-5
     world.add_sphere(position=(3, 0, 0), radius=1e-4)
     assert world.model.contact_slop() == pytest.approx(1e-7)
+
+
+def test_the_contact_record_names_balls_by_intp_indices_whatever_the_pairs_keep():
+    """The record's ``a`` and ``b`` are the platform's index type in every step (the kept pairs hold
+    int32 indices to save memory; a step with one batch of contacts hands that batch on as it is)."""
+    world = ballpit.World(gravity=(0.0, 0.0, 0.0))
+    world.add_spheres(
+        [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], radius=0.5, velocity=[[2.0, 0.0, 0.0], [-2.0, 0.0, 0.0]]
+    )
+    records = [world.step(0.01) for _ in range(40)]
+    touched = [r for r in records if len(r.a)]
+    assert touched, "the balls never met"
+    for r in touched:
+        assert r.a.dtype == np.intp and r.b.dtype == np.intp
+        assert sorted((int(r.a[0]), int(r.b[0]))) == [0, 1]

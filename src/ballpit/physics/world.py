@@ -293,7 +293,8 @@ class World:
         )
         awake = pipeline.wake(step)
         plan = pipeline.plan(step, awake.collision, awake.motion)
-        checkpoint = Checkpoint.of(self.parts)  # the one undo: a soft frame's retry, a non-finite step
+        # the one undo: a soft frame's retry, a non-finite step (the balls copied when they first change)
+        checkpoint = Checkpoint.of(self.parts, balls_later=True)
         taken = pipeline.solve(step, awake, plan, checkpoint)
         pipeline.settle(step, awake)
         record = pipeline.finish(step, checkpoint, plan, len(awake.collision.pairs))

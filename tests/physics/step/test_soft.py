@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from ballpit.physics.contact import jacobi
 from ballpit.physics.core.settings import RETRIES
 from ballpit.physics.step import soft
 from ballpit.physics.step.checkpoint import Checkpoint
@@ -28,7 +29,7 @@ def judged_always(monkeypatch, verdict: soft.Verdict) -> list[int]:
     """Every try judged ``verdict``; returns the list each try is counted in."""
     tries = []
 
-    def judge(step, motion, gaps, solved, c, frame, before):
+    def judge(step, motion, left, c, frame, before):
         tries.append(frame)
         return verdict
 
@@ -79,3 +80,24 @@ def test_a_step_whose_soft_frame_failed_is_split_at_impacts_exactly_as_if_planne
     assert np.array_equal(tried.state.body, split.state.body)
     assert np.array_equal(tried_contacts.impulse, split_contacts.impulse)
     assert np.array_equal(tried.parts.warm.keys, split.parts.warm.keys)
+
+
+def test_soft_frames_solved_a_few_contacts_at_a_time_end_in_the_same_bits_as_solved_whole(monkeypatch):
+    """The sweeps, the normal speeds and the mass split form their per-contact values SWEEP_CHUNK
+    contacts at a time (a settled pile's memory); every value is one contact's own and the per-ball
+    sums are still one bincount over all contacts, so chunks of 7 contacts leave a heap thrown onto
+    a floor (a few hundred contacts) exactly where whole sweeps leave it."""
+
+    def fallen(chunk: int | None) -> tuple[np.ndarray, np.ndarray]:
+        if chunk is not None:
+            monkeypatch.setattr(jacobi, "SWEEP_CHUNK", chunk)
+        world = pile_on_a_floor(side=6, r=0.1, substeps=4)
+        world.spheres.velocities[:] = (0.3, -0.5, 0.1)
+        for _ in range(12):
+            world.step(1 / 60)
+        assert world.crowded_steps > 0
+        return world.spheres.positions.copy(), world.spheres.angular_velocities.copy()
+
+    whole, chunked = fallen(None), fallen(7)
+    assert np.array_equal(whole[0], chunked[0])
+    assert np.array_equal(whole[1], chunked[1])

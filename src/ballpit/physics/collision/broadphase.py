@@ -29,11 +29,18 @@ _OFFSETS = np.array(
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For each k, the integers starts[k] … starts[k]+counts[k]−1, flattened, with their owner k."""
+    """For each k, the integers starts[k] … starts[k]+counts[k]−1, flattened, with their owner k (as
+    int32 while every number fits: a first search for pairs makes a few dozen of them a ball)."""
     total = int(counts.sum())
-    owner = np.repeat(np.arange(len(counts)), counts)
-    first = np.cumsum(counts) - counts
-    return owner, np.arange(total) - first[owner] + starts[owner]
+    index = _index_type(total + len(counts), int(starts.max(initial=0)) + total)
+    owner = np.repeat(np.arange(len(counts), dtype=index), counts)
+    first = np.cumsum(counts, dtype=index) - counts
+    return owner, np.arange(total, dtype=index) - first[owner] + starts[owner]
+
+
+def _index_type(*largest: int) -> type:
+    """int32 when every one of the ``largest`` values fits, else int64."""
+    return np.int32 if max(largest) < 2**31 else np.int64
 
 
 def _overlap(lo: np.ndarray, hi: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -138,15 +145,21 @@ def _dense_candidates(key: np.ndarray, dims: np.ndarray, cells: int) -> tuple[np
     """Candidate pairs (places in ``key``) from a table of every cell's first ball and count: each ball
     with the later balls of its own cell and every ball of its 13 forward neighbours."""
     n = len(key)
-    order = np.argsort(key, kind="stable")
-    per_cell = np.bincount(key, minlength=cells + 1)
-    first_in_cell = np.cumsum(per_cell) - per_cell
+    # ball places, cells and counts as int32 while they fit (the tables below are 14 a ball)
+    index = _index_type(cells + 1 + int(np.abs(_neighbour_steps(dims)).max()), 14 * n)
+    order = np.argsort(key, kind="stable").astype(index)
+    per_cell = np.bincount(key, minlength=cells + 1).astype(index)
+    first_in_cell = np.cumsum(per_cell, dtype=index) - per_cell
     # every ball's own cell and its 13 forward neighbours at once
-    neighbour = (key[None, :] + _neighbour_steps(dims)[:, None]).ravel()  # offset-major: own cells first
-    neighbour = np.minimum(neighbour, cells)  # past the last cell: the empty sentinel
+    steps = _neighbour_steps(dims).astype(index)
+    neighbour = (key.astype(index)[None, :] + steps[:, None]).ravel()  # offset-major: own cells first
+    np.minimum(neighbour, cells, out=neighbour)  # past the last cell: the empty sentinel
     start, count = np.take(first_in_cell, neighbour), np.take(per_cell, neighbour)
+    del neighbour
     owner, pos = _ranges(start, count)
+    del start, count
     i, j = owner % n, np.take(order, pos)
+    del pos
     keep = (owner >= n) | (i < j)  # own cell: each pair once, never a ball with itself
     return i[keep], j[keep]
 

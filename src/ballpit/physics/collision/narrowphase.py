@@ -35,14 +35,17 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
         model.planes.half_size,
     )
     gs, ns, ps = geometry.sphere_sphere(x, radius, c.pair_i, c.pair_j)
-    static = np.full(len(c.sphere), model.spheres.count)
+    # the pairs' own index type (int32 while the balls' rows fit, ``pairs.find_pairs``): 4 bytes an
+    # index, not 8, in every array the frame takes of them
+    index = c.pair_i.dtype
+    static = np.full(len(c.sphere), model.spheres.count, index)
     kind = np.full(len(gp) + len(gs), SPHERE_SPHERE, np.int8)  # one byte a pair
     kind[: len(gp)] = SPHERE_PLANE
     return ContactPoints(
         kind=kind,
-        a=np.concatenate((c.sphere, c.pair_i)),
-        b=np.concatenate((static, c.pair_j)),
-        other=np.concatenate((c.plane, c.pair_j)),
+        a=np.concatenate((c.sphere, c.pair_i), dtype=index),
+        b=np.concatenate((static, c.pair_j), dtype=index),
+        other=np.concatenate((c.plane, c.pair_j), dtype=index),
         gap=np.concatenate((gp, gs)),
         normal=np.concatenate((np_, ns)),
         point=np.concatenate((pp, ps)),

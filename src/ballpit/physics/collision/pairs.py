@@ -237,7 +237,7 @@ def find_pairs(
     hi += pad
     rows = tuple(np.ascontiguousarray(c.T) for c in (lo, hi, centre))  # (N, 3), for the broad phase
     i, j = broadphase.within_reach(*broadphase.sphere_pairs(rows[0], rows[1]), rows[2], reach)
-    if n < 2**31:  # kept for many steps: 4 bytes a ball index, not 8 (the narrow phase widens them)
+    if n < 2**31:  # kept for many steps: 4 bytes a ball index, not 8 (and so are the contacts measured)
         i, j = i.astype(np.int32), j.astype(np.int32)
     s, p = plane_pairs(model, state, rows[0], rows[1], ahead)
     del rows  # kept as views of the columns: one copy of the boxes, not two (72 bytes a ball)

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import exact
-from ..core.settings import ADD_UP_BINS_UP_TO, CONVERGED
+from ..core.settings import ADD_UP_BINS_UP_TO, CONVERGED, SWEEP_CHUNK
 from . import contact_model as model
 from .contact_model import Impulses
 from .ends import Ends
@@ -51,7 +51,6 @@ class ContactColumns(Ends):
         self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
         self.iia, self.iib = contacts.inv_inertia_a, contacts.inv_inertia_b
         self.ra, self.rb = contacts.arm_lengths()
-        self.minus_ra, self.minus_rb = -self.ra, -self.rb
         self.n = np.ascontiguousarray(contacts.normal.T)
         # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse (the rows'
         # own arrays: ``_full_sweep`` forms their (2, K) block for each sweep)
@@ -77,30 +76,74 @@ class ContactColumns(Ends):
         # one row of scratch instead of six (80 bytes a contact less)
         self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
         self.motion = np.empty((2, 3, k))
+        self.m_n: np.ndarray | None = None
+        self.m_tr: np.ndarray | None = None
         self.split()
 
     def normal_speeds(self, v: np.ndarray) -> np.ndarray:
         """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it
         on spheres), against a moving plane's surface: the contact model's ``normal_speed`` on these
         columns."""
-        g = np.take(v[:3], self.ends, axis=1)
-        return model.normal_speed(g[:, : self.k], g[:, self.k :], self.n, self.surface)
+        k = self.k
+        if k <= SWEEP_CHUNK:
+            g = np.take(v[:3], self.ends, axis=1)
+            return model.normal_speed(g[:, :k], g[:, k:], self.n, self.surface)
+        vn = np.empty(k)  # SWEEP_CHUNK contacts at a time: the gathers of a chunk, not of all
+        for lo in range(0, k, SWEEP_CHUNK):
+            part = slice(lo, min(lo + SWEEP_CHUNK, k))
+            v_a = np.take(v[:3], self.ends[:k][part], axis=1)
+            v_b = np.take(v[:3], self.ends[k:][part], axis=1)
+            surface = None if self.surface is None else self.surface[:, part]
+            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface)
+        return vn
 
     def split(self, pushing: np.ndarray | None = None) -> None:
         """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
-        each): the effective masses ``m_n`` and ``m_tr`` (friction, then rolling, as (2, 1, K))."""
+        each): each ball's ``shares`` and the effective masses ``m_n`` and ``m_tr`` (friction, then
+        rolling, as (2, 1, K)). Beyond SWEEP_CHUNK contacts, ``m_n`` is formed a chunk at a time into
+        the array of the last split (a soft frame splits once a substep) and m_t, m_r where a full
+        sweep's chunk uses them (``tangent_masses``): not kept, 16 bytes a contact."""
         k = self.k
         if pushing is None:
             share = self.share
         else:
             counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
             share = np.maximum(counts, 1.0)
-        sa, sb = share[self.ends[:k]], share[self.ends[k:]]
-        m_n, m_t, m_r = model.effective_masses(
-            sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
+        self.shares = share
+        if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept
+            sa, sb = share[self.ends[:k]], share[self.ends[k:]]
+            self.m_n, m_t, m_r = model.effective_masses(
+                sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
+            )
+            self.m_tr = np.stack((m_t, m_r))[:, None, :]
+            return
+        if self.m_n is None:
+            self.m_n = np.empty(k)
+        for lo in range(0, k, SWEEP_CHUNK):
+            part = slice(lo, min(lo + SWEEP_CHUNK, k))
+            sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
+            # model.effective_masses' m_n: 1/(n_a·m_a⁻¹ + n_b·m_b⁻¹)
+            inv_n = sa * self.ima[part]
+            inv_n += sb * self.imb[part]
+            np.divide(1.0, inv_n, out=self.m_n[part])
+
+    def tangent_masses(self, part: slice) -> np.ndarray:
+        """The friction and rolling effective masses m_t, m_r of the contacts ``part`` as (2, 1, chunk),
+        with the masses split as the last ``split`` split them (``model.effective_masses``)."""
+        if self.k <= SWEEP_CHUNK:
+            return self.m_tr
+        k, share = self.k, self.shares
+        sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
+        m_t_r = np.empty((2, 1, len(sa)))
+        _, m_t_r[0, 0], m_t_r[1, 0] = model.effective_masses(
+            sa * self.ima[part],
+            sb * self.imb[part],
+            sa * self.iia[part],
+            sb * self.iib[part],
+            self.ra[part],
+            self.rb[part],
         )
-        self.m_n = m_n
-        self.m_tr = np.stack((m_t, m_r))[:, None, :]
+        return m_t_r
 
 
 def solve(
@@ -190,10 +233,7 @@ def apply(
     linear += d_t
     np.negative(linear, out=push[:3, k:])
     exact.cross_cols(c.n, d_t, out=turn)  # model.turn: n × P_t
-    np.multiply(turn, c.minus_ra, out=push[3:, :k])
-    push[3:, :k] += d_r
-    turn *= c.minus_rb
-    turn -= d_r
+    _turns(turn, push[3:, :k], c.ra, c.rb, d_r)
     total = c.add_up(push)
     by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
     by_kind *= c.inverse[:, None, :]
@@ -206,23 +246,35 @@ def _apply_by_rows(
     """``apply`` one row of pushes at a time in ``row`` (2K,): each row's values, and so its sums per
     ball, are those of the (6, 2K) block."""
     k, n = c.k, c.n
-    total = np.empty((6, c.m))
     at_a, at_b = row[:k], row[k:]
     for r in range(3):  # Δv: ±(P_n·n + P_t)
         np.multiply(normal, n[r], out=at_a)
         at_a += d_t[r]
         np.negative(at_a, out=at_b)
-        total[r] = c.add_row(row)
+        _add_row(c, vw[r], row, c.inverse[0])
     for r in range(3):  # Δω: −ρ·(n × P_t) ± R
         exact.cross_col(n, d_t, r, out=at_b)
-        np.multiply(at_b, c.minus_ra, out=at_a)
-        at_a += d_r[r]
-        at_b *= c.minus_rb
-        at_b -= d_r[r]
-        total[3 + r] = c.add_row(row)
-    by_kind = total.reshape(2, 3, c.m)  # a view: v's three rows, then ω's
-    by_kind *= c.inverse[:, None, :]
-    vw += total
+        _turns(at_b, at_a, c.ra, c.rb, d_r[r])
+        _add_row(c, vw[3 + r], row, c.inverse[1])
+
+
+def _add_row(c: ContactColumns, into: np.ndarray, row: np.ndarray, inverse: np.ndarray) -> None:
+    """Add one row of pushes per contact end, summed per ball and times each ball's m⁻¹ or I⁻¹, to
+    ``into``: a row of the (rows, M) sums at a time, not the whole block."""
+    summed = c.add_row(row)
+    summed *= inverse
+    into += summed
+
+
+def _turns(turn: np.ndarray, at_a: np.ndarray, ra: np.ndarray, rb: np.ndarray, d_r: np.ndarray) -> None:
+    """Δω's pushes from ``turn`` = n × P_t: −ρ_a·turn + R into ``at_a``, and −ρ_b·turn − R into
+    ``turn`` itself. Formed as R − ρ_a·turn and −(ρ_b·turn + R), the same values as (−ρ_a)·turn + R and
+    (−ρ_b)·turn − R (negation is exact), without keeping the negated radii (16 bytes a contact)."""
+    np.multiply(turn, ra, out=at_a)
+    np.subtract(d_r, at_a, out=at_a)
+    turn *= rb
+    turn += d_r
+    np.negative(turn, out=turn)
 
 
 def _normal_sweep(
@@ -238,19 +290,19 @@ def _normal_sweep(
     k, n = c.k, c.n
     vn = c.normal_speeds(vw)
     new = model.normal_impulse(normal, m_n, target, vn, give)
-    d_n = new - normal
+    d_n = np.subtract(new, normal, out=vn)  # in v_n's array, used up
+    del vn
     if len(push) == 1:  # one row at a time (``apply``)
-        total = np.empty((3, c.m))
         row = push[0]
         for r in range(3):
             np.multiply(d_n, n[r], out=row[:k])
             np.negative(row[:k], out=row[k:])
-            total[r] = c.add_row(row)
-    else:
-        lin = push[:3]
-        np.multiply(d_n, n, out=lin[:, :k])
-        np.negative(lin[:, :k], out=lin[:, k:])
-        total = c.add_up(lin)
+            _add_row(c, vw[r], row, c.inverse[0])
+        return new
+    lin = push[:3]
+    np.multiply(d_n, n, out=lin[:, :k])
+    np.negative(lin[:, :k], out=lin[:, k:])
+    total = c.add_up(lin)
     total *= c.inverse[0]
     vw[:3] += total
     return new
@@ -270,42 +322,82 @@ def _full_sweep(
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """One sweep of normal, friction and rolling impulses, all from the velocities at its start;
     ``vw`` changes in place. Returns the impulses and (when ``measure``) a bound on the largest
-    velocity change it made at any contact (m/s)."""
-    k, n = c.k, c.n
-    ea, eb = c.ends[:k], c.ends[k:]
+    velocity change it made at any contact (m/s).
+
+    The new impulses are formed SWEEP_CHUNK contacts at a time (``_full_chunk``) into ``motion``
+    (the new tangential impulses) and the changes into the old impulses' block, which then is the
+    next sweep's ``motion``: two (2, 3, K) blocks, and the temporaries of one chunk."""
+    k = c.k
+    new = np.empty(k)
+    d_n = np.empty(k)
+    change = 0.0
+    for lo in range(0, k, SWEEP_CHUNK):
+        part = slice(lo, min(lo + SWEEP_CHUNK, k))
+        found = _full_chunk(c, vw, normal, tangential, target, motion, m_n, give, part, new, d_n, measure)
+        change = max(change, found)
+    c.motion = tangential
+    apply(c, vw, push, d_n, tangential)
+    return new, motion, change
+
+
+def _full_chunk(
+    c: ContactColumns,
+    vw: np.ndarray,
+    normal: np.ndarray,
+    tangential: np.ndarray,
+    target: np.ndarray,
+    motion: np.ndarray,
+    m_n: np.ndarray,
+    give: np.ndarray | float | None,
+    part: slice,
+    new: np.ndarray,
+    d_n: np.ndarray,
+    measure: bool,
+) -> float:
+    """``_full_sweep`` for the contacts ``part``: their new normal impulses into ``new`` and the
+    changes into ``d_n``; their new tangential impulses into ``motion`` and the changes into
+    ``tangential``. Returns the largest velocity change among them (when ``measure``)."""
+    k = c.k
+    n = c.n[:, part]
+    ea, eb = c.ends[:k][part], c.ends[k:][part]
+    ra, rb = c.ra[part], c.rb[part]
+    slip, spin = motion[0][:, part], motion[1][:, part]
     # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
-    # (3, K) part at a time, each dropped once used, not as one (6, 2K) block
+    # (3, chunk) part at a time, each dropped once used
     wa, wb = np.take(vw[3:], ea, axis=1), np.take(vw[3:], eb, axis=1)
-    np.subtract(wa, wb, out=motion[1])  # the relative spin, for rolling resistance
-    lever = model.spin_lever(wa, wb, c.ra, c.rb)
+    np.subtract(wa, wb, out=spin)  # the relative spin, for rolling resistance
+    lever = model.spin_lever(wa, wb, ra, rb)
     del wa, wb
     dv = np.take(vw[:3], ea, axis=1)
     dv -= np.take(vw[:3], eb, axis=1)
-    rel = model.point_velocity(dv, lever, n, c.surface)
+    rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part])
     del lever
     vn = exact.dot_cols(rel, n)
-    new = model.normal_impulse(normal, m_n, target, vn, give)
-    d_n = new - normal
+    old = normal[part]
+    fresh = model.normal_impulse(old, _part(m_n, part), _part(target, part), vn, _part(give, part))
+    new[part] = fresh
+    np.subtract(fresh, old, out=d_n[part])
     # friction cancels slip inside the Coulomb cone; rolling resistance opposes relative spin
-    np.multiply(vn, n, out=motion[0])
-    np.subtract(rel, motion[0], out=motion[0])
+    np.multiply(vn, n, out=slip)
+    np.subtract(rel, slip, out=slip)
     del dv, rel
     if c.spin is not None:
-        motion[1] -= c.spin
-    # the new impulses are formed in the slip's scratch and the change in the old impulses' block,
-    # which then is the next sweep's scratch: three (2, 3, K) blocks at a time, not four
-    candidate = motion
-    candidate *= c.m_tr
-    np.subtract(tangential, candidate, out=candidate)
-    limits = np.empty((2, k))
-    np.multiply(c.friction, new, out=limits[0])
-    np.multiply(c.rolling, new, out=limits[1])
-    new_tr = model.within_limit(candidate, limits)
-    del limits
-    d_tr = np.subtract(new_tr, tangential, out=tangential)
-    c.motion = d_tr
-    apply(c, vw, push, d_n, d_tr)
-    change = 0.0
-    if measure:
-        change = max(float(np.abs(d_n).max()) * c.inv_m_n, float(np.abs(d_tr[0]).max()) * c.inv_m_t)
-    return new, new_tr, change
+        spin -= c.spin[:, part]
+    # the new impulses are formed in the slip's scratch, the change in the old impulses' block
+    candidate = motion[:, :, part]
+    candidate *= c.tangent_masses(part)
+    before = tangential[:, :, part]
+    np.subtract(before, candidate, out=candidate)
+    limits = np.empty((2, len(vn)))
+    np.multiply(c.friction[part], fresh, out=limits[0])
+    np.multiply(c.rolling[part], fresh, out=limits[1])
+    model.within_limit(candidate, limits)
+    np.subtract(candidate, before, out=before)
+    if not measure:
+        return 0.0
+    return max(float(np.abs(d_n[part]).max()) * c.inv_m_n, float(np.abs(before[0]).max()) * c.inv_m_t)
+
+
+def _part(x: np.ndarray | float | None, part: slice) -> np.ndarray | float | None:
+    """The contacts ``part`` of a per-contact array; a number (or None) stands for every contact."""
+    return x[part] if isinstance(x, np.ndarray) and x.ndim else x

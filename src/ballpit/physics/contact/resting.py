@@ -51,15 +51,27 @@ class WarmStart:
         """Put back the warm start ``saved`` (a ``checkpoint``; it stays usable)."""
         self.__dict__.update(vars(saved))
 
+    def _found(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which of the pairs ``keys`` are kept, and where (the kept rows of those found)."""
+        pos = np.searchsorted(self.keys, keys)
+        pos = np.minimum(pos, len(self.keys) - 1)
+        found = self.keys[pos] == keys
+        return found, pos[found]
+
+    def normal_impulses(self, keys: np.ndarray, h: float) -> np.ndarray:
+        """The normal part of ``impulses``."""
+        normal = np.zeros(len(keys))
+        if len(self.keys):
+            found, src = self._found(keys)
+            normal[found] = self.forces.normal[src] * h
+        return normal
+
     def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""
         imp = Impulses.zeros(len(keys))
         if len(self.keys) == 0:
             return imp
-        pos = np.searchsorted(self.keys, keys)
-        pos = np.minimum(pos, len(self.keys) - 1)
-        found = self.keys[pos] == keys
-        src = pos[found]
+        found, src = self._found(keys)
         imp.normal[found] = self.forces.normal[src] * h
         friction = self.forces.friction[src] * h
         n = normal[found]

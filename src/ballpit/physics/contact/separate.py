@@ -51,18 +51,22 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
     made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -SLOP_RETURN * slop), made)
     part = np.flatnonzero(made < -SEPARATE_REACH * made.min())
     pos = with_static(body[:, X])
-    normals = np.take(c.normal.T, part, axis=1).T  # laid out as (3, K) columns, as separate reads them
+    # the contacts ``part``; every contact (a settled pile) as the frame holds them, not copies
+    every = len(part) == len(made)
+    take = (lambda a: a) if every else (lambda a: a[part])
+    # the normals laid out as (3, K) columns, as separate reads them (``c.normal`` is)
+    normals = c.normal if every else np.take(c.normal.T, part, axis=1).T
     penetration.separate(
-        c.a[part],
-        c.b[part],
+        take(c.a),
+        take(c.b),
         normals,
-        made[part],
-        rows.inv_mass_a[part],
-        rows.inv_mass_b[part],
+        take(made),
+        take(rows.inv_mass_a),
+        take(rows.inv_mass_b),
         pos,
         SEPARATE_SWEEPS,
     )
-    del normals
+    del normals, made
     new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
     energy_guard.pay_for_lift(model, state, body[:, X], new)
     moved = new - body[:, X]
@@ -114,4 +118,4 @@ def hold_apart(f: SoftFrame, state: State, warm: WarmStart, s: np.ndarray) -> No
     s_end = f.separation(f.dt)
     s_eq = f.normal * f.whole * f.soft("impulse_scale") / (f.soft("mass_scale") * f.soft("bias_rate"))
     held = np.minimum(f.apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
-    warm.keep_apart(f.keys, np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
+    warm.keep_apart(f.keys(), np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))

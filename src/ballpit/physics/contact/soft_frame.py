@@ -68,19 +68,35 @@ class SoftFrame:
             softness(hertz, DAMPING_RATIO, h),
             softness(PLANE_STIFFNESS * hertz, DAMPING_RATIO, h),
         )
-        self.vn_start = k.normal_speeds(vw)  # recorded at the frame's start, for the restitution pass
-        self.keys = c.keys()
-        imp = warm.impulses(self.keys, c.normal, h)
-        self.apart = warm.apart_of(self.keys)
-        self.normal = imp.normal.copy()
+        # the pairs' keys, the warm start's normal impulses and the normal speeds at the frame's start
+        # are found again when needed (``keys``, ``came_with``, ``start_speeds``), not held through the
+        # substeps (24 bytes a contact each)
+        keys = c.keys()
+        imp = warm.impulses(keys, c.normal, h)
+        self.apart = warm.apart_of(keys)
+        self.normal = imp.normal
         self.tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-        self.came_with = (
-            imp.normal
-        )  # the warm start's normal impulses; its friction and rolling are in tangential
+        del imp
         self.total = np.zeros(kc)
         self.least = c.gap.copy()
         self.farthest, self.largest = np.zeros(m), np.zeros(m)
         self.lo, self.hi = x[:, live].copy(), x[:, live].copy()
+
+    def keys(self) -> np.ndarray:
+        """The pairs' keys (``ContactPoints.keys``)."""
+        return self.c.keys()
+
+    def came_with(self, warm: WarmStart) -> np.ndarray:
+        """The normal impulses the frame was warm-started with, from ``warm`` as it was then (before
+        ``store_impulses`` keeps the frame's)."""
+        return warm.normal_impulses(self.keys(), self.h)
+
+    def start_speeds(self, state: State) -> np.ndarray:
+        """Each contact's normal speed at the frame's start, from the balls' velocities in ``state``
+        (not yet written back): the same columns and the same sums as the frame's own velocities then."""
+        v = np.zeros((3, self.k.m))
+        v[:, self.live] = state.body[self.idx, V].T
+        return self.k.normal_speeds(v)
 
     def soft(self, name: str) -> np.ndarray:
         """Each contact's soft coefficient ``name`` (a ``Softness`` field), made when used (K floats)."""

@@ -40,7 +40,8 @@ that carry the load.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -55,6 +56,9 @@ from . import impacts, jacobi, separate
 from .contact_model import Impulses
 from .resting import WarmStart
 from .soft_frame import SoftFrame
+
+# the contact rows' columns no stage reads once the impulses are stored (``store_impulses``)
+_ROWS_DONE = ("radius_a", "radius_b", "inv_inertia_a", "inv_inertia_b", "restitution", "friction", "rolling")
 
 
 @dataclass
@@ -83,10 +87,13 @@ def frame(
     warm: WarmStart,
     substeps: int,
     profile: StepProfile,
+    before_write: Callable[[], None] | None = None,
 ) -> Frame:
     """Advance the balls the contacts ``c`` touch by ``dt`` in ``substeps`` substeps (their states
     change in place; planes and other balls do not move here). ``warm`` gives and keeps the impulses;
-    ``threshold`` is the restitution threshold (m/s). Each stage is timed into ``profile``."""
+    ``threshold`` is the restitution threshold (m/s). Each stage is timed into ``profile``.
+    ``before_write`` is called just before the balls' states first change (the step's undo copies
+    them then, ``Checkpoint.keep_balls``)."""
     with profile.stage(Stage.PREPARE_CONTACTS):
         f = SoftFrame(model, state, c, forces, dt, warm, substeps)
     for i in range(substeps):
@@ -101,9 +108,9 @@ def frame(
         with profile.stage(Stage.RELAX):
             relax(f, i)
     with profile.stage(Stage.RESTITUTION):
-        added = restitution(f, model, threshold)
+        added = restitution(f, model, state, threshold)
     with profile.stage(Stage.STORE_IMPULSES):
-        store_impulses(f, model, state, warm, added)
+        store_impulses(f, model, state, warm, added, before_write)
     with profile.stage(Stage.SEPARATE):
         s = separate.move_apart(f, model, state)
         separate.planes_win(f, model, state)
@@ -134,9 +141,17 @@ def solve(f: SoftFrame, i: int) -> None:
     k.split((f.normal > 0.0) | (s + PUSH_AHEAD * np.minimum(k.normal_speeds(vw), 0.0) * h < 0.0))
     speculative = s > 0.0
     target = np.where(speculative, -s / h, np.minimum(-f.soft("bias_rate") * (s - f.apart), MAX_PUSH))
-    scale = np.where(speculative, 1.0, f.soft("mass_scale"))
+    del s
+    # the sweeps' m_n·scale and give·m_n·(1/m_n unsplit), each formed in its own array
+    m_n = np.where(speculative, 1.0, f.soft("mass_scale"))
+    m_n *= k.m_n
     give = np.where(speculative, 0.0, f.soft("impulse_scale"))
-    f.normal, f.tangential = _soft_sweeps(k, vw, f.normal, f.tangential, target, scale, give, SOLVE_SWEEPS)
+    del speculative
+    give *= k.m_n
+    give *= k.whole
+    f.normal, f.tangential = jacobi.sweeps(
+        k, vw, f.normal, f.tangential, target, SOLVE_SWEEPS, friction_every=SOLVE_SWEEPS, m_n=m_n, give=give
+    )
 
 
 def integrate_positions(f: SoftFrame) -> None:
@@ -164,7 +179,7 @@ def relax(f: SoftFrame, i: int) -> None:
     f.total += f.normal
 
 
-def restitution(f: SoftFrame, model: Model, threshold: float) -> np.ndarray:
+def restitution(f: SoftFrame, model: Model, state: State, threshold: float) -> np.ndarray:
     """The frame's impacts, by the rule of the split step (impacts in waves, ``impacts.waves_from``):
     when a contact that pushed during the frame closed faster than ``threshold`` at its start, the
     waves are run from those starting normal speeds over the contacts that pushed, and the contacts
@@ -175,8 +190,9 @@ def restitution(f: SoftFrame, model: Model, threshold: float) -> np.ndarray:
     convergence (``impacts.normal_solve``). Returns the impulse added per contact (also in ``total``)."""
     rows, k, normal, pressed = f.rows, f.k, f.normal, f.total > 0.0
     added = np.zeros(len(normal))
-    if (pressed & (f.vn_start < -threshold) & (rows.restitution > 0.0)).any():
-        after, struck = impacts.waves_from(model, rows, k, f.vw, f.vn_start, threshold, pressed)
+    vn_start = f.start_speeds(state)
+    if (pressed & (vn_start < -threshold) & (rows.restitution > 0.0)).any():
+        after, struck = impacts.waves_from(model, rows, k, f.vw, vn_start, threshold, pressed)
         # the pressed contacts beside a struck one take part too: a ball the waves left still holds on them
         touched = np.zeros(k.m, bool)
         touched[k.ends[: k.k][struck]] = True
@@ -192,8 +208,16 @@ def restitution(f: SoftFrame, model: Model, threshold: float) -> np.ndarray:
     return added
 
 
-def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, added: np.ndarray) -> None:
-    """Keep the impulses for the next frame's warm start, and write the balls back into the state.
+def store_impulses(
+    f: SoftFrame,
+    model: Model,
+    state: State,
+    warm: WarmStart,
+    added: np.ndarray,
+    before_write: Callable[[], None] | None = None,
+) -> None:
+    """Keep the impulses for the next frame's warm start, and write the balls back into the state
+    (calling ``before_write`` first).
 
     A level contact (its normal within LEVEL of square to gravity: it holds up no weight) that the
     restitution ``added`` to keeps no more warm start than it came with: its last substep's impulse was
@@ -201,16 +225,24 @@ def store_impulses(f: SoftFrame, model: Model, state: State, warm: WarmStart, ad
     still."""
     g, n = model.gravity, f.n
     level = np.abs(exact.dot_cols(g, n)) <= LEVEL * exact.norm_rows(g)
-    kept = np.where((added != 0.0) & level, np.minimum(f.normal, f.came_with), f.normal)
-    warm.keep(f.keys, Impulses(kept, f.tangential[0].T.copy(), f.tangential[1].T.copy()), f.h)
+    bounced = (added != 0.0) & level
+    kept = np.where(bounced, np.minimum(f.normal, f.came_with(warm)), f.normal) if bounced.any() else f.normal
+    # what follows needs of the solve only each contact's 1/m_n: its columns and scratch go now, before
+    # the undo copies the balls and the warm start makes its own sorted copies of the impulses
+    f.whole = f.k.whole
+    f.k = None
+    if before_write is not None:
+        before_write()
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T
     body[idx, W] = f.vw[3:, live].T
     body[idx, Q] = f.q
-    # what follows needs of the solve only each contact's 1/m_n: its scratch and impulses go now
-    f.whole = f.k.whole
-    f.k = f.vw = f.q = f.tangential = f.came_with = f.vn_start = None
+    tangential = f.tangential
+    f.vw = f.q = f.tangential = None
+    warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    # what moving apart reads of the rows: the bodies, the inverse masses and the planes' surfaces
+    f.rows = replace(f.rows, **dict.fromkeys(_ROWS_DONE))
 
 
 def _soft_sweeps(

@@ -167,7 +167,8 @@ class EventLog:
             return ContactRecord.empty()
         if len(self._parts) == 1:  # one add: one entry per pair already, in order, at one time
             time, c, _, impulse = self._parts[0]
-            return ContactRecord(time, c.kind.astype(np.int8), c.a, c.other, c.point, c.normal, impulse)
+            a, b = c.a.astype(np.intp, copy=False), c.other.astype(np.intp, copy=False)  # pairs keep int32
+            return ContactRecord(time, c.kind.astype(np.int8), a, b, c.point, c.normal, impulse)
         time = np.concatenate([p[0] for p in self._parts])
         keys = np.concatenate([p[2] for p in self._parts])
         impulse = np.concatenate([p[3] for p in self._parts])
@@ -181,8 +182,8 @@ class EventLog:
         return ContactRecord(
             time=time[first],
             kind=c.kind[first].astype(np.int8),
-            a=c.a[first],
-            b=c.other[first],
+            a=c.a[first].astype(np.intp),
+            b=c.other[first].astype(np.intp),
             point=c.point[first],
             normal=c.normal[first],
             impulse=total[order],

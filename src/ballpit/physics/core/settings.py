@@ -239,6 +239,11 @@ SORT_ENDS_FROM = 8
 # Beyond it, one np.bincount a row, as fast at that size, and the bins are not kept: at 100,000 balls
 # they were 6 rows × 2 ends × 8 bytes a contact, about 290 bytes a ball in a settled pile.
 ADD_UP_BINS_UP_TO = 1 << 17
+# A full Jacobi sweep forms its per-contact temporaries (the gathered spins and velocities, the slip,
+# the friction candidates) this many contacts at a time: every value is one contact's own, so the
+# impulses are the same, and a settled pile of 100,000 balls holds a few chunks' worth of them, not
+# about 290 bytes a ball.
+SWEEP_CHUNK = 1 << 14
 # Resting forces found over less than this fraction of a step do not warm-start the next solve.
 WARM_START_SPAN = 0.5
 # Planes win (resting.hold_by_planes): when the resting solve leaves a ball sinking into a plane (or a

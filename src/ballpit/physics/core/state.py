@@ -194,9 +194,10 @@ class State:
         self.sleep = Sleep()
         self.sleep.fit(self.count)
 
-    def checkpoint(self) -> SavedState:
+    def checkpoint(self, balls: bool = True) -> SavedState:
         """What ``restore`` needs to put this state back: copies of the balls' block and of the planes'
-        poses, the time, and the sleep bookkeeping (whose arrays are never changed in place)."""
+        poses, the time, and the sleep bookkeeping (whose arrays are never changed in place). Without
+        ``balls`` the balls' block is not copied (``body`` None): it is to be copied before it changes."""
         pose = self.planes  # its PLANE_POSE columns, in that order
         poses = (
             pose.center.copy(),
@@ -205,11 +206,13 @@ class State:
             pose.axis_u.copy(),
             pose.axis_v.copy(),
         )
-        return SavedState(self.body.copy(), poses, self.time, shallow_copy(self.sleep))
+        return SavedState(self.body.copy() if balls else None, poses, self.time, shallow_copy(self.sleep))
 
     def restore(self, saved: SavedState) -> None:
-        """Put back the state ``saved`` (a ``checkpoint``; it stays usable)."""
-        _put_back(self._rows, ("body",), (saved.body,))
+        """Put back the state ``saved`` (a ``checkpoint``; it stays usable). A checkpoint without the
+        balls' block was taken of balls not changed since."""
+        if saved.body is not None:
+            _put_back(self._rows, ("body",), (saved.body,))
         _put_back(self.planes, PLANE_POSE, saved.poses)
         self.time = saved.time
         self.sleep = shallow_copy(saved.sleep)
@@ -218,7 +221,7 @@ class State:
 class SavedState(NamedTuple):
     """A state as it was (``State.checkpoint``)."""
 
-    body: np.ndarray  # (N, 13)
+    body: np.ndarray | None  # (N, 13); None until copied (``Checkpoint.keep_balls``)
     poses: tuple[np.ndarray, ...]  # the planes' pose columns, as PLANE_POSE names them
     time: float
     sleep: Sleep

@@ -86,8 +86,9 @@ def forces_of(forces: list[ForceTerm], idx: np.ndarray, n_balls: int) -> list[Fo
 def free_acceleration(body: np.ndarray, forces: list[ForceTerm]) -> tuple[np.ndarray, np.ndarray]:
     """Linear and angular acceleration of each ball from the force terms alone, at state ``body``."""
     constant = constant_acceleration(forces)
-    if constant is not None:  # the same sums, made once (or once per ball) and repeated
-        return tuple(a.repeat(len(body), axis=0) if len(a) == 1 else a for a in constant)
+    if constant is not None:  # the same sums, made once (or once per ball), seen by every ball
+        # a read-only view of the one row, not N copies of it (48 bytes a ball)
+        return tuple(np.broadcast_to(a, (len(body), 3)) if len(a) == 1 else a for a in constant)
     lin = np.zeros((len(body), 3))
     ang = np.zeros((len(body), 3))
     for term in forces:

@@ -61,10 +61,13 @@ def solve(step: Step, awake: Awake, chosen: Plan, checkpoint: Checkpoint) -> Str
     Returns how it was taken."""
     collision = awake.collision
     if chosen.strategy is Strategy.SOFT:
-        if soft.frames(step, awake.motion, collision, chosen, checkpoint):
+        taken = soft.frames(step, awake.motion, collision, chosen, checkpoint)
+        checkpoint.keep_balls(step.parts)  # before anything after the solve changes the balls
+        if taken:
             return Strategy.SOFT
         contacts = measure(step, collision.pairs)  # the frame took the contacts: the same again
     else:
+        checkpoint.keep_balls(step.parts)
         contacts = collision.take()
     split.split_at_impacts(step, awake.motion, contacts, collision.pairs)
     return Strategy.SPLIT

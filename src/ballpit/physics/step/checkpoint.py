@@ -48,14 +48,29 @@ class Checkpoint:
     saved: dict[str, object]
 
     @staticmethod
-    def of(parts: Parts) -> Checkpoint:
-        """The parts as they are now."""
-        return Checkpoint({name: getattr(parts, name).checkpoint() for name in _PARTS})
+    def of(parts: Parts, balls_later: bool = False) -> Checkpoint:
+        """The parts as they are now. With ``balls_later`` the balls' block is copied only by
+        ``keep_balls``, which whatever changes the balls calls first: a soft frame solves on columns of
+        its own and writes the balls back at its end, so while it solves the block is held once, not
+        twice (104 bytes a ball)."""
+        saved = {name: getattr(parts, name).checkpoint() for name in _PARTS if name != "state"}
+        saved["state"] = parts.state.checkpoint(balls=not balls_later)
+        return Checkpoint(saved)
+
+    def keep_balls(self, parts: Parts) -> None:
+        """Copy the balls' block of ``parts`` into this checkpoint, if it was taken without it
+        (``balls_later``): to be called before the balls first change."""
+        saved = self.saved["state"]
+        if saved.body is None:
+            self.saved["state"] = saved._replace(body=parts.state.body.copy())
 
     @property
     def state(self) -> SavedState:
         """The state as it was: the balls' (N, 13) block, the planes' poses, the time, sleep."""
-        return self.saved["state"]
+        saved = self.saved["state"]
+        if saved.body is None:
+            raise RuntimeError("the checkpoint's balls are copied when they first change (keep_balls)")
+        return saved
 
     def restore(self, parts: Parts) -> None:
         """Put every part back as it was (the checkpoint stays usable: it can be restored again)."""

@@ -76,9 +76,9 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     # then this memory, not a copy of it)
     c.normal = np.asfortranarray(c.normal)
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
-    # them), and of the others only which bodies they join and their gaps: the kept pairs' normals,
-    # points and b go, 56 bytes a pair
-    gaps = contacts.gaps()
+    # them), and of the others, the pairs left out, only which bodies they join and their gaps
+    left = contacts.gaps().subset(~solved)
+    del solved
     del contacts
     for substeps in [plan.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
@@ -86,7 +86,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
         if fast[c.a].any() or fast[c.b].any():  # too fast for a substep: not worth a try
             continue
         last = substeps == plan.substeps << RETRIES
-        frame = _try(step, motion, gaps, solved, c, substeps, last, checkpoint)
+        frame = _try(step, motion, left, c, substeps, last, checkpoint)
         if frame is not None:
             break
     else:
@@ -99,8 +99,7 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
 def _try(
     step: Step,
     motion: Motion,
-    gaps: ContactPoints,
-    solved: np.ndarray,
+    left: ContactPoints,
     c: ContactPoints,
     substeps: int,
     last: bool,
@@ -112,10 +111,19 @@ def _try(
     overlapping balls at impacts jumps them apart by positions."""
     model, state, dt = step.model, step.state, step.dt
     n = model.spheres.count
-    body_before = checkpoint.state.body  # the balls as the frame found them
     frame = softstep.frame(
-        model, state, c, motion.forces, dt, step.restitution_threshold, step.warm, substeps, step.profile
+        model,
+        state,
+        c,
+        motion.forces,
+        dt,
+        step.restitution_threshold,
+        step.warm,
+        substeps,
+        step.profile,
+        lambda: checkpoint.keep_balls(step.parts),
     )
+    body_before = checkpoint.state.body  # the balls as the frame found them
     balls = frame.balls[frame.balls < n]
     others = np.ones(n, bool)
     others[balls] = False
@@ -129,7 +137,7 @@ def _try(
             state.body[others] = rows
     moving_planes.advance(model, state, dt)
     with step.profile.stage(Stage.TIME_OF_IMPACT):
-        found = verdict(step, motion, gaps, solved, c, frame, body_before)
+        found = verdict(step, motion, left, c, frame, body_before)
     if found is Verdict.KEPT or (last and found is Verdict.DEEPER):
         return frame
     checkpoint.restore(step.parts)  # undo it all
@@ -139,16 +147,15 @@ def _try(
 def verdict(
     step: Step,
     motion: Motion,
-    gaps: ContactPoints,
-    solved: np.ndarray,
+    left: ContactPoints,
     c: ContactPoints,
     frame: softstep.Frame,
     before: np.ndarray,
 ) -> Verdict:
     """Whether a soft frame kept its promises (see ``frames``), or why it cannot be trusted.
 
-    ``gaps`` are the kept pairs' gaps at the frame's start (``ContactPoints.gaps``), ``solved`` which
-    of them the frame solved (``c``) and ``before`` the balls' states then. A ball that left the box
+    ``left`` are the kept pairs the frame did not solve (``c``), with their gaps at the frame's start
+    (``ContactPoints.gaps``), and ``before`` the balls' states then. A ball that left the box
     its pairs were found from may have met a body the broad phase never paired it with: the pairs are
     then found afresh around where the balls are now (they replace the kept pairs, as a split step's
     renewal does) and those new pairs are checked too."""
@@ -184,7 +191,7 @@ def verdict(
         out = now.subset(~np.isin(now.keys(), c.keys()))
         out.gap = _gap_from(out, before, model, state)
     else:
-        out = gaps.subset(~solved)
+        out = left
         b = np.where(out.kind == SPHERE_PLANE, n, out.other)
         near = far[out.a] + far[b] >= out.gap  # only those whose balls got farther than their gap
         out = out.subset(near)
