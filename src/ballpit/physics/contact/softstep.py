@@ -53,8 +53,8 @@ from ..dynamics.forces import ForceTerm, column_accelerations
 from ..dynamics.model import Model
 from . import impacts, jacobi, separate
 from .contact_model import Impulses
-from .resting import WarmStart
 from .soft_frame import SoftFrame
+from .warm_start import WarmStart
 
 
 @dataclass
