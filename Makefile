@@ -1,5 +1,6 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
-# `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min).
+# `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min);
+# `make test` runs every test on every core (pytest-xdist; a window batch keeps to one worker, tests/conftest.py).
 # demo installs what ballpit itself needs and PyAV (F9 records MP4); test adds the test tools (pytest, ruff,
 # scipy, ...).
 PYTHON ?= python3
@@ -29,7 +30,7 @@ check: $(VENV)/.installed
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest
+	$(PY) -m pytest -n auto --dist loadgroup
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
