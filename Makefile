@@ -6,6 +6,7 @@
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
+PYTEST_ARGS ?=  # more for pytest: make test PYTEST_ARGS=--durations=20
 
 .PHONY: demo check test lint format bench clean
 
@@ -25,12 +26,12 @@ demo: $(VENV)/.ballpit
 check: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -q -n auto -m "not slow and not window"
+	$(PY) -m pytest -q -n auto -m "not slow and not window" $(PYTEST_ARGS)
 
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -n auto --dist loadgroup
+	$(PY) -m pytest -n auto --dist loadgroup $(PYTEST_ARGS)
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
