@@ -61,7 +61,7 @@ class WarmStart:
         asleep): sleeping pairs are not solved, so the next ``keep`` would forget them, and a pile woken
         with no warm start sags under its own weight and springs back up, gaining energy."""
         held = _asleep_pairs(self.keys, asleep)
-        if not held.any():
+        if not np.count_nonzero(held):
             return
         self.asleep = _merged(self.asleep, _rows((self.keys, self.forces, self.apart), held))
 
@@ -76,7 +76,7 @@ class WarmStart:
             return
         woken = ~still
         fresh = ~np.isin(keys[woken], self.keys)  # a pair solved since keeps what it was solved to
-        back = np.flatnonzero(woken)[fresh]
+        back = woken.nonzero()[0][fresh]
         merged = _merged((self.keys, self.forces, self.apart), _rows(self.asleep, back))
         self.keys, self.forces, self.apart = merged
         self.asleep = _rows(self.asleep, still)
