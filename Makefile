@@ -1,10 +1,12 @@
 # Two commands do all the set-up: `make demo` opens the viewer, `make test` runs the checks.
-# `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min).
+# `make check` is the inner loop: lint, format and the tests marked neither slow nor window, on every core (< 1 min);
+# `make test` runs every test on every core (pytest-xdist; a window batch keeps to one worker, tests/conftest.py).
 # demo installs what ballpit itself needs and PyAV (F9 records MP4); test adds the test tools (pytest, ruff,
 # scipy, ...).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
+PYTEST_ARGS ?=  # more for pytest: make test PYTEST_ARGS=--durations=20
 
 .PHONY: demo check test lint format bench clean
 
@@ -24,12 +26,12 @@ demo: $(VENV)/.ballpit
 check: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -q -n auto -m "not slow and not window"
+	$(PY) -m pytest -q -n auto -m "not slow and not window" $(PYTEST_ARGS)
 
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest
+	$(PY) -m pytest -n auto --dist loadgroup $(PYTEST_ARGS)
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

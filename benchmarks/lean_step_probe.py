@@ -36,7 +36,7 @@ import numpy as np
 from ballpit.physics.collision import broadphase, narrowphase
 from ballpit.physics.collision.pairs import KeptPairs, plane_pairs, plane_sides
 from ballpit.physics.contact import jacobi, rows, solver
-from ballpit.physics.contact.resting import WarmStart
+from ballpit.physics.contact.warm_start import WarmStart
 from ballpit.physics.core.contacts import ContactPoints
 from ballpit.physics.core.settings import CONTACT_SLOP
 from ballpit.physics.core.state import V, W, X, with_static

@@ -1,5 +1,9 @@
 """Markers for the whole suite: a test that uses the ``xvfb`` or ``offscreen`` fixture (tests/viewer/
-conftest.py) is a ``window`` test without saying so; ``slow`` ones say so themselves."""
+conftest.py) is a ``window`` test without saying so; ``slow`` ones say so themselves.
+
+Under pytest-xdist (``make test``: ``-n auto --dist loadgroup``) the tests of a module that runs its
+window scenarios as one batch (a module-level ``BATCH``: tests/viewer/conftest.py's ``run_driver``)
+share one worker, so the batch runs once, not once on every worker its tests land on."""
 
 from __future__ import annotations
 
@@ -16,7 +20,11 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 WINDOW_FIXTURES = frozenset({"xvfb", "offscreen", "offscreen_session"})
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's loadgroup reads the groups
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         if WINDOW_FIXTURES.intersection(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.window)
+        module = getattr(item, "module", None)
+        if getattr(module, "BATCH", None):
+            item.add_marker(pytest.mark.xdist_group(module.__name__))

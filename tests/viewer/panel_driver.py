@@ -319,6 +319,11 @@ def energy_legend(workdir: Path) -> dict:
     return out
 
 
+# How many frames the record scenario waits for the video to catch up with the window (it takes one
+# or two): recording that failed never does.
+RECORD_WAIT_FRAMES = 120
+
+
 def _open_record_section(viewer: Viewer) -> None:
     """Fold the sections above it and open "Record video", so its button is on screen."""
     collapse(viewer, "Scenes", "Simulation", "Inspector")
@@ -337,8 +342,15 @@ def record_button(workdir: Path) -> dict:
     out: dict = {"recording": video.is_recording, "panel_width": viewer.panel.width}
     pump(viewer, 60)
     pump(viewer, 1)
-    while video.clock.last != viewer.shown.time:  # the state shown now is one the video holds
+    for _ in range(RECORD_WAIT_FRAMES):  # until the state shown now is one the video holds
+        if video.clock.last == viewer.shown.time:
+            break
         pump(viewer, 1)
+    else:
+        raise AssertionError(
+            f"no frame of the video holds the state shown after {RECORD_WAIT_FRAMES} more frames "
+            f"(recording: {video.is_recording}, video frames: {video.clock.frames}): did recording fail?"
+        )
     image = grab(viewer)
     out["window"] = str(workdir / "window.png")
     Image.fromarray(image.astype(np.uint8)).save(out["window"])

@@ -9,7 +9,7 @@ import numpy as np
 
 from .collision import geometry
 from .collision.pairs import PairCache
-from .contact.resting import WarmStart
+from .contact.warm_start import WarmStart
 from .core import exact, quaternion, validation
 from .core.state import State, X
 from .dynamics import moving_planes

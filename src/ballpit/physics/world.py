@@ -1,9 +1,9 @@
 """The World: the facade over the physics. Its parameters, ``add_*``, the live views, and ``step``.
 
-What a World is lives in ``model`` (what a step reads: ball properties, planes and parameters;
-model.py) and ``parts`` (what a step changes, checkpoint.py): the ``state`` (state.py) and two caches
-that change results, the broad phase's kept pairs (pairs.py) and the warm-start forces (resting.py).
-``step`` is the pipeline of typed stages of step/, one a line.
+A World is its ``model`` (what a step reads: balls, planes, parameters; dynamics/model.py) and its
+``parts`` (what a step changes; step/checkpoint.py): the ``state`` and the two caches that change
+results, the kept pairs (collision/pairs.py) and the warm start (contact/warm_start.py). ``step`` runs
+the typed stages of step/, one a line.
 """
 
 from __future__ import annotations
@@ -112,15 +112,14 @@ class World:
     )
     sleep = Flag(
         "Whether balls that have stayed still together for half a second fall asleep (cost nothing, "
-        "move not at all) until something reaches them (sleeping.py). Off by default."
+        "move not at all) until something reaches them (dynamics/sleeping.py). Off by default."
     )
 
     @property
     def asleep(self) -> np.ndarray:
         """Which balls are asleep now (a read-only copy, one flag per ball)."""
-        sleep = self.state.sleep
-        sleep.fit(self.model.spheres.count)
-        flags = sleep.asleep.copy()
+        self.state.sleep.fit(self.model.spheres.count)
+        flags = self.state.sleep.asleep.copy()
         flags.flags.writeable = False
         return flags
 
@@ -293,8 +292,7 @@ class World:
         )
         awake = pipeline.wake(step)
         plan = pipeline.plan(step, awake.collision, awake.motion)
-        # the one undo: a soft frame's retry, a non-finite step (the balls copied when they first change)
-        checkpoint = Checkpoint.of(self.parts, balls_later=True)
+        checkpoint = Checkpoint.of(self.parts, balls_later=True)  # the one undo (balls: when changed)
         taken = pipeline.solve(step, awake, plan, checkpoint)
         pipeline.settle(step, awake)
         record = pipeline.finish(step, checkpoint, plan, len(awake.collision.pairs))

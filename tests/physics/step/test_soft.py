@@ -4,7 +4,7 @@ only fault is a contact that overlapped deeper; else the step is split at impact
 planned so.
 
 The verdict on each try is replaced here (the rule that acts on it is what is checked); the verdict's
-own checks are tests/physics/test_softstep.py's and test_robustness.py's."""
+own checks are tests/physics/contact/test_softstep.py's and test_robustness.py's."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Narrow phase: exact distances and contact frames for sphere–rectangle and sphere–sphere pairs.
+"""Geometry: exact distances and contact frames for sphere–rectangle and sphere–sphere pairs.
 
 A plane is a rectangle (or an unbounded plane, with infinite half extents) in the frame
 (center, u, v, normal). The closest point on it to a ball's centre is found by clamping the in-plane

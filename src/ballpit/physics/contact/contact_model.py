@@ -203,7 +203,7 @@ def stick(
     D = 1/m_t − c²·m_r = 1/m_a + 1/m_b + (ρ_a + ρ_b)²/(I_a·I_b·(1/I_a + 1/I_b)), which is at least
     1/m_a + 1/m_b (written so: against a plane, D is 1/m_a exactly).
     """
-    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, 1e-300)
+    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, NO_ZERO_DIVIDE)
     c = arm_a * inv_inertia_a - arm_b * inv_inertia_b
     reach = arm_a + arm_b
     d = (inv_mass_a + inv_mass_b) + inv_inertia_a * inv_inertia_b * reach * reach / inv_r

@@ -29,8 +29,8 @@ from ..core.settings import (
 from ..core.state import State, X, with_static
 from ..dynamics.model import Model
 from . import energy_guard, penetration
-from .resting import WarmStart
 from .soft_frame import SoftFrame
+from .warm_start import WarmStart
 
 
 def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:

@@ -13,8 +13,8 @@ from ..dynamics.forces import ForceTerm, constant_acceleration, forces_of
 from ..dynamics.model import Model
 from . import jacobi
 from .contact_model import softness
-from .resting import WarmStart
 from .rows import contact_rows
+from .warm_start import WarmStart
 
 
 class SoftFrame:

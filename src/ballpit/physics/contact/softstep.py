@@ -54,8 +54,8 @@ from ..dynamics.forces import ForceTerm, column_accelerations
 from ..dynamics.model import Model
 from . import impacts, jacobi, separate
 from .contact_model import Impulses
-from .resting import WarmStart
 from .soft_frame import SoftFrame
+from .warm_start import WarmStart
 
 # the contact rows' columns no stage reads once the impulses are stored (``store_impulses``)
 _ROWS_DONE = ("radius_a", "radius_b", "inv_inertia_a", "inv_inertia_b", "restitution", "friction", "rolling")

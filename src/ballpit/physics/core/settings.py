@@ -61,6 +61,9 @@ NEW_DIRECTION = 1e-6
 # Added to a squared length (or an inverse inertia sum) before it divides: no 0/0 where it is zero.
 # Far below any impulse², inertia⁻¹ or length² a step forms, and far above the smallest double.
 NO_ZERO_DIVIDE = 1e-300
+# A ball's orientation may have any length a step can normalise (every step does): not one whose squared
+# length (dimensionless) underflows to nothing (a zero quaternion) or overflows (steppable.py).
+SHORTEST_TURN2 = 1e-24
 
 # --- Broad phase (pairs.py, broadphase.py) ------------------------------------------------------------
 

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from .settings import SHORTEST_TURN2
 from .state import Q
 from .validation import MAX_COORDINATE, MAX_SPEED, MAX_SPIN, UNIT_TOLERANCE
 
@@ -20,11 +21,6 @@ _STATE_FIELDS = (
 )
 _STATE_LIMITS = np.concatenate([np.full(stop - start, lim) for _, start, stop, lim in _STATE_FIELDS])
 _SMALLEST_LIMIT = float(_STATE_LIMITS.min())
-
-
-# A ball's orientation may have any length a step can normalise (every step does): not one whose squared
-# length underflows to nothing (a zero quaternion) or overflows.
-_SHORTEST_TURN2 = 1e-24
 
 
 class LastGoodBalls:
@@ -108,7 +104,7 @@ def _turnable(body: np.ndarray) -> np.ndarray:
     q = body[:, Q]
     with np.errstate(over="ignore"):  # a square that overflows is what this looks for
         q2 = q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] + q[:, 2] * q[:, 2] + q[:, 3] * q[:, 3]
-    return (q2 >= _SHORTEST_TURN2) & (q2 < math.inf)
+    return (q2 >= SHORTEST_TURN2) & (q2 < math.inf)
 
 
 def _unturnable(body: np.ndarray) -> str | None:

@@ -36,14 +36,7 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
     if len(lin) != len(ang):  # one per ball, the other shared
         lin, ang = np.broadcast_to(lin, (n, 3)), np.broadcast_to(ang, (n, 3))
     per_ball = len(lin) > 1
-    # the v and ω parts of acc·(h/6): the six k's added one by one, as ``rk4`` does (v and ω side by
-    # side, the same sums for each)
-    both = np.concatenate((lin, ang), axis=1)
-    d = both + both
-    for _ in range(4):
-        d += both
-    d *= sixth
-    dv, dw = d[:, :3], d[:, 3:]
+    dv, dw = _velocity_steps(lin, ang, sixth)
     lin_half, lin_h = lin * half, lin * h
     ang_half = ang_h = None  # ω's trial increments, made when some ball spins
     cols = ws.get("rk4 columns", (_ROWS, RK4_CHUNK))
@@ -100,6 +93,17 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
         q_rows = rows[:, Q]
         q /= np.sqrt(np.einsum("...i,...i->...", q_rows, q_rows))
         np.copyto(q_rows, q.T)
+
+
+def _velocity_steps(lin: np.ndarray, ang: np.ndarray, sixth: float) -> tuple[np.ndarray, np.ndarray]:
+    """The v and ω parts of acc·(h/6) (``sixth`` = h/6): the six k's added one by one, as ``rk4`` does
+    (v and ω side by side, the same sums for each)."""
+    both = np.concatenate((lin, ang), axis=1)
+    d = both + both
+    for _ in range(4):
+        d += both
+    d *= sixth
+    return d[:, :3], d[:, 3:]
 
 
 _NEGATIVE_ZERO = np.array(-0.0).view(np.int64)

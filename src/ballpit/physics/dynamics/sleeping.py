@@ -10,7 +10,7 @@ settled pile is the state most scenes spend most of their time in. The rules, as
   leaves it where it is: its pairs with other sleeping balls and with planes are not measured or
   solved, and a holding force cancels its free acceleration, so it neither falls nor drifts. The
   warm start of its pairs is put aside while it sleeps and given back when it wakes
-  (``resting.WarmStart.put_to_sleep`` and ``wake``), so a woken pile holds where it was.
+  (``warm_start.WarmStart.put_to_sleep`` and ``wake``), so a woken pile holds where it was.
 - An island wakes whole when an awake ball touches one of its balls or could reach one within the
   step (the same bound the crowd test uses), when a step leaves one of its balls moving, or when one
   of its balls is moved or set moving by hand. Changing gravity or the radii, moving any plane, or

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 from ..collision.pairs import PairCache
-from ..contact.resting import WarmStart
+from ..contact.warm_start import WarmStart
 from ..core.state import SavedState, State
 
 

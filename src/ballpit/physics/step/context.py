@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..collision.pairs import PairCache
-from ..contact.resting import WarmStart
+from ..contact.warm_start import WarmStart
 from ..core.contacts import EventLog
 from ..core.profile import Stage, StepProfile
 from ..core.state import State

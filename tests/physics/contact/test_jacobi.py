@@ -5,7 +5,7 @@ slide or stick on the floor."""
 import numpy as np
 import pytest
 
-from ballpit.physics.contact import jacobi, solver
+from ballpit.physics.contact import columns, jacobi, solver
 from ballpit.physics.contact.contact_model import Impulses
 from ballpit.physics.contact.rows import ContactRows
 from ballpit.physics.core.settings import JACOBI_FROM, JACOBI_SWEEPS
@@ -145,7 +145,7 @@ def test_adding_up_one_row_at_a_time_gives_the_same_bits_as_the_kept_bins(monkey
     from ballpit.scene import read_scene, resolve_scene_path
 
     def landed(bins: int) -> np.ndarray:
-        monkeypatch.setattr(jacobi, "ADD_UP_BINS_UP_TO", bins)
+        monkeypatch.setattr(columns, "ADD_UP_BINS_UP_TO", bins)
         scene = read_scene(resolve_scene_path("pile"))
         for _ in range(75):  # into the landing: every frame crowded, the overlaps moved apart
             scene.world.step(scene.timestep)

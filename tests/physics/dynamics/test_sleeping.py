@@ -187,6 +187,7 @@ def test_still_means_below_the_sleep_speed_in_translation_and_in_spin():
     assert world.asleep.tolist() == [False, True]  # spinning at 1.5× the sleep speed; drifting at half
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sleep", [False, True])
 def test_a_closed_elastic_frictionless_box_never_gains_energy_with_sleeping_on_or_off(sleep):
     # A layer of balls resting apart on the floor (they fall asleep after TIME_TO_SLEEP when sleeping

@@ -83,6 +83,7 @@ def sink_in_radii(world: ballpit.World) -> np.ndarray:
     return np.maximum(beyond, np.maximum(r - x[:, 1], x[:, 1] + r - 0.6)) / r
 
 
+@pytest.mark.slow  # eight chains, the slowest tests make check ran (66 s of its 268 s under load 7)
 @pytest.mark.parametrize("integrator", ["euler", "rk2", "rk4", "symplectic"])
 @pytest.mark.parametrize(
     ("masses", "radii"),

@@ -1,0 +1,123 @@
+"""The contacts as the Jacobi sweeps read them (jacobi.py): one column per contact, vectors as (3, K) rows,
+gathered once per solve."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.settings import ADD_UP_BINS_UP_TO, SWEEP_CHUNK
+from . import contact_model as model
+from .ends import Ends
+from .rows import ContactRows
+
+
+class ContactColumns(Ends):
+    """What the sweeps need of the contacts, gathered once per solve, with vectors as (3, K) rows.
+
+    Velocities are the rows of one (6, M) array [v; ω] of just the M balls the contacts touch; ``ends``
+    are the columns of each contact's a then b. A sweep gathers both ends with one ``np.take`` and adds
+    every contact's impulse to its two balls with one ``np.bincount``. Laid out by component, every
+    other operation is on contiguous rows of K numbers, without broadcasting over a short axis.
+    Friction and rolling resistance are solved as one (2, 3, K) block: the same update and the same
+    cap, with their own effective masses and limits (zero limits where a material has none).
+    """
+
+    def __init__(self, contacts: ContactRows) -> None:
+        super().__init__(contacts.a, contacts.b)
+        k, m = self.k, self.m
+        self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
+        self.iia, self.iib = contacts.inv_inertia_a, contacts.inv_inertia_b
+        self.ra, self.rb = contacts.arm_lengths()
+        self.n = np.ascontiguousarray(contacts.normal.T)
+        # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse (the rows'
+        # own arrays: ``jacobi._full_sweep`` forms their (2, K) block for each sweep)
+        self.friction, self.rolling = contacts.friction, contacts.rolling
+        # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
+        inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
+        inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
+        inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = self.iia, self.iib
+        self.inverse = np.stack((inv_mass, inv_inertia))  # (2, M): m⁻¹ for v's rows, I⁻¹ for ω's
+        # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
+        # velocity, for the convergence test
+        inv_n, inv_t, _ = model.inverse_effective_masses(
+            self.ima, self.imb, self.iia, self.iib, self.ra, self.rb
+        )
+        self.whole = inv_n
+        self.inv_m_n, self.inv_m_t = float(inv_n.max()), float(inv_t.max())
+        self.moving = contacts.moving
+        self.surface = np.ascontiguousarray(contacts.surface.T) if self.moving else None
+        self.spin = np.ascontiguousarray(contacts.spin.T) if self.moving else None
+        # scratch for what each contact adds to its a (columns :K) then its b (K:), and for the slip
+        # at the contact point and the relative spin (friction, rolling), kept for every sweep; beyond
+        # ADD_UP_BINS_UP_TO entries the pushes are made and added up one row at a time (``apply``), in
+        # one row of scratch instead of six (80 bytes a contact less)
+        self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
+        self.motion = np.empty((2, 3, k))
+        self.m_n: np.ndarray | None = None
+        self.m_tr: np.ndarray | None = None
+        self.split()
+
+    def normal_speeds(self, v: np.ndarray) -> np.ndarray:
+        """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it
+        on spheres), against a moving plane's surface: the contact model's ``normal_speed`` on these
+        columns."""
+        k = self.k
+        if k <= SWEEP_CHUNK:
+            g = np.take(v[:3], self.ends, axis=1)
+            return model.normal_speed(g[:, :k], g[:, k:], self.n, self.surface)
+        vn = np.empty(k)  # SWEEP_CHUNK contacts at a time: the gathers of a chunk, not of all
+        for lo in range(0, k, SWEEP_CHUNK):
+            part = slice(lo, min(lo + SWEEP_CHUNK, k))
+            v_a = np.take(v[:3], self.ends[:k][part], axis=1)
+            v_b = np.take(v[:3], self.ends[k:][part], axis=1)
+            surface = None if self.surface is None else self.surface[:, part]
+            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface)
+        return vn
+
+    def split(self, pushing: np.ndarray | None = None) -> None:
+        """Split each ball's mass among its contacts, or among those ``pushing`` only (at least one share
+        each): each ball's ``shares`` and the effective masses ``m_n`` and ``m_tr`` (friction, then
+        rolling, as (2, 1, K)). Beyond SWEEP_CHUNK contacts, ``m_n`` is formed a chunk at a time into
+        the array of the last split (a soft frame splits once a substep) and m_t, m_r where a full
+        sweep's chunk uses them (``tangent_masses``): not kept, 16 bytes a contact."""
+        k = self.k
+        if pushing is None:
+            share = self.share
+        else:
+            counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
+            share = np.maximum(counts, 1.0)
+        self.shares = share
+        if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept
+            sa, sb = share[self.ends[:k]], share[self.ends[k:]]
+            self.m_n, m_t, m_r = model.effective_masses(
+                sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
+            )
+            self.m_tr = np.stack((m_t, m_r))[:, None, :]
+            return
+        if self.m_n is None:
+            self.m_n = np.empty(k)
+        for lo in range(0, k, SWEEP_CHUNK):
+            part = slice(lo, min(lo + SWEEP_CHUNK, k))
+            sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
+            # model.effective_masses' m_n: 1/(n_a·m_a⁻¹ + n_b·m_b⁻¹)
+            inv_n = sa * self.ima[part]
+            inv_n += sb * self.imb[part]
+            np.divide(1.0, inv_n, out=self.m_n[part])
+
+    def tangent_masses(self, part: slice) -> np.ndarray:
+        """The friction and rolling effective masses m_t, m_r of the contacts ``part`` as (2, 1, chunk),
+        with the masses split as the last ``split`` split them (``model.effective_masses``)."""
+        if self.k <= SWEEP_CHUNK:
+            return self.m_tr
+        k, share = self.k, self.shares
+        sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
+        m_t_r = np.empty((2, 1, len(sa)))
+        _, m_t_r[0, 0], m_t_r[1, 0] = model.effective_masses(
+            sa * self.ima[part],
+            sb * self.imb[part],
+            sa * self.iia[part],
+            sb * self.iib[part],
+            self.ra[part],
+            self.rb[part],
+        )
+        return m_t_r
