@@ -289,10 +289,18 @@ class World:
         step = pipeline.prepare(
             self.model, self.parts, self._workspace, dt, self._good_planes, self._good_balls
         )
-        awake = pipeline.wake(step)
-        plan = pipeline.plan(step, awake.collision, awake.motion)
-        checkpoint = Checkpoint.of(self.parts)  # the one undo: a soft frame's retry, a non-finite step
-        taken = pipeline.solve(step, awake, plan, checkpoint)
+        while True:
+            awake = pipeline.wake(step)
+            plan = pipeline.plan(step, awake.collision, awake.motion)
+            checkpoint = Checkpoint.of(self.parts)  # the undo: a soft frame's retry, a non-finite step
+            taken = pipeline.solve(step, awake, plan, checkpoint)
+            struck = pipeline.struck(step)
+            if struck is None:
+                break
+            # a sleeping ball met inside the step was held as a wall: wake its island, solve again
+            checkpoint.restore(self.parts)
+            self.state.sleep.wake(struck)
+            step = step.again()
         pipeline.settle(step, awake)
         record = pipeline.finish(step, checkpoint, plan, len(awake.collision.pairs))
         self._after_step(step, taken)

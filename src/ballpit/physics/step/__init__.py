@@ -1,6 +1,7 @@
 """A step as a pipeline of typed stages (docs/architecture.md draws it; ``World.step`` reads as it):
 
-    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> settle -> finish
+    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> struck -> settle
+        -> finish
 
 - ``prepare``: refuse what cannot be stepped; the step's settings and outputs (``Step``).
 - ``wake`` (sleep.py): wake what was moved by hand, collide (collide.py: the kept pairs and the
@@ -8,6 +9,8 @@
 - ``plan`` (plan.py): the crowd test, split at impacts or a soft frame of n substeps.
 - ``solve``: the soft frame (soft.py, softstep.py), tried with more substeps while it cannot keep its
   promises, else the step split at every impact (split.py).
+- ``struck`` (sleep.py): an impulse that reached a sleeping ball (met by a path no contact foresaw)
+  sends ``World.step`` back to the checkpoint, with that ball's island awake, to take the step again.
 - ``settle`` (sleep.py): still islands fall asleep.
 - ``finish``: undo a step that made anything non-finite; the time, the record and the profile.
 
@@ -31,9 +34,21 @@ from . import soft, split
 from .collide import measure
 from .context import Step
 from .plan import Plan, Strategy, plan
-from .sleep import Awake, settle, wake
+from .sleep import Awake, settle, struck, wake
 
-__all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "settle", "solve", "wake"]
+__all__ = [
+    "Awake",
+    "Plan",
+    "Step",
+    "Strategy",
+    "finish",
+    "plan",
+    "prepare",
+    "settle",
+    "solve",
+    "struck",
+    "wake",
+]
 
 
 def prepare(
