@@ -33,12 +33,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ballpit.physics import broadphase, jacobi, narrowphase, rows, solver
-from ballpit.physics.contacts import ContactPoints
-from ballpit.physics.pairs import KeptPairs, plane_pairs, plane_sides
-from ballpit.physics.resting import WarmStart
-from ballpit.physics.settings import CONTACT_SLOP
-from ballpit.physics.state import V, W, X, with_static
+from ballpit.physics.collision import broadphase, narrowphase
+from ballpit.physics.collision.pairs import KeptPairs, plane_pairs, plane_sides
+from ballpit.physics.contact import jacobi, rows, solver
+from ballpit.physics.contact.resting import WarmStart
+from ballpit.physics.core.contacts import ContactPoints
+from ballpit.physics.core.settings import CONTACT_SLOP
+from ballpit.physics.core.state import V, W, X, with_static
 from ballpit.scene import read_scene
 
 ROOT = Path(__file__).resolve().parents[1]

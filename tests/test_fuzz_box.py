@@ -42,7 +42,7 @@ from hypothesis import HealthCheck, Phase, example, given, settings
 from hypothesis import strategies as st
 
 import ballpit
-from ballpit.physics.integrators import INTEGRATOR_NAMES
+from ballpit.physics.dynamics.integrators import INTEGRATOR_NAMES
 from ballpit.scene import read_scene
 
 pytestmark = pytest.mark.slow  # a hypothesis search over whole runs: `make test`, not `make check`

@@ -107,3 +107,22 @@ def test_the_physics_imports_no_layer_above_it_and_no_window():
         names = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
         names |= {n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
         assert not {m for m in names if m.split(".")[0] in ("pyglet", "OpenGL")}, path
+
+
+ROOMS = ("core", "dynamics", "collision", "contact", "step")  # each imports only those before it
+
+
+def room(module: str) -> int | None:
+    """Where ``module`` sits in ROOMS (None for the physics' root modules: the facade over them all)."""
+    parts = module.split(".")
+    return ROOMS.index(parts[2]) if len(parts) > 2 and parts[2] in ROOMS else None
+
+
+def test_each_physics_room_imports_only_the_rooms_below_it():
+    rooms = {p.name for p in (SRC / "ballpit" / "physics").iterdir() if (p / "__init__.py").exists()}
+    assert rooms == set(ROOMS)
+    for name, targets in graph("ballpit.physics", hints=True).items():
+        if (here := room(name)) is None:
+            continue
+        above = {t for t in targets if room(t) is None or room(t) > here}
+        assert not above, (name, above)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ballpit.physics.integrators import INTEGRATORS
+from ballpit.physics.dynamics.integrators import INTEGRATORS
 from ballpit.scene import bundled_scenes, load_scene, read_scene
 from ballpit.viewer.camera import Camera
 

@@ -99,7 +99,7 @@ def read_profile(stdout: str) -> tuple[dict[str, float], str]:
 @pytest.mark.slow
 @pytest.mark.parametrize(("scene", "crowded"), [("slopes", False), ("pile", True)])
 def test_profile_prints_the_time_of_every_stage_and_the_counts_per_step(scene, crowded):
-    from ballpit.physics.profile import STAGES
+    from ballpit.physics.core.profile import STAGES
 
     command = ["simulate", f"scenes/{scene}.toml", "--duration", "0.8", "--profile", "-q"]
     r = run_in_process(*command, cwd=ROOT)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ballpit.physics import broadphase
+from ballpit.physics.collision import broadphase
 
 
 def brute_force_pairs(lo: np.ndarray, hi: np.ndarray) -> set[tuple[int, int]]:

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.checkpoint import Checkpoint, Parts
 from ballpit.physics.step import soft
+from ballpit.physics.step.checkpoint import Checkpoint, Parts
 from ballpit.scene import load_scene, resolve_scene_path
 
 G = 9.81

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics import impacts, narrowphase, rows
-from ballpit.physics.contacts import EventLog
-from ballpit.physics.forces import free_acceleration
-from ballpit.physics.settings import EnergyGuards
+from ballpit.physics.collision import narrowphase
+from ballpit.physics.contact import impacts, rows
+from ballpit.physics.core.contacts import EventLog
+from ballpit.physics.core.settings import EnergyGuards
+from ballpit.physics.dynamics.forces import free_acceleration
 
 G = 9.81
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ballpit.physics import exact
+from ballpit.physics.core import exact
 
 
 def _ulps(got: np.ndarray, want: np.ndarray) -> np.ndarray:

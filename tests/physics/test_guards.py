@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics import validation
+from ballpit.physics.core import validation
 
 
 def test_gravity_reads_as_a_read_only_array_so_nan_cannot_be_written_into_it():

@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics import impacts, narrowphase, rows
-from ballpit.physics.contacts import EventLog
-from ballpit.physics.forces import free_acceleration
-from ballpit.physics.settings import MAX_WAVES
+from ballpit.physics.collision import narrowphase
+from ballpit.physics.contact import impacts, rows
+from ballpit.physics.core.contacts import EventLog
+from ballpit.physics.core.settings import MAX_WAVES
+from ballpit.physics.dynamics.forces import free_acceleration
 
 G = 9.81
 R = 0.1  # m, the cradle's balls

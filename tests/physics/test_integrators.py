@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics import quaternion
-from ballpit.physics.forces import ConstantPerBall, Gravity, constant_acceleration
-from ballpit.physics.integrators import (
+from ballpit.physics.core import quaternion
+from ballpit.physics.core.settings import RK4_CHUNK
+from ballpit.physics.core.state import Q, V, W, X
+from ballpit.physics.dynamics.forces import ConstantPerBall, Gravity, constant_acceleration
+from ballpit.physics.dynamics.integrators import (
     INTEGRATOR_NAMES,
     INTEGRATORS,
     Workspace,
@@ -17,8 +19,6 @@ from ballpit.physics.integrators import (
     rk4,
     rk4_constant,
 )
-from ballpit.physics.settings import RK4_CHUNK
-from ballpit.physics.state import Q, V, W, X
 
 G = 9.81
 

@@ -5,10 +5,10 @@ slide or stick on the floor."""
 import numpy as np
 import pytest
 
-from ballpit.physics import jacobi, solver
-from ballpit.physics.contact_model import Impulses
-from ballpit.physics.rows import ContactRows
-from ballpit.physics.settings import JACOBI_FROM, JACOBI_SWEEPS
+from ballpit.physics.contact import jacobi, solver
+from ballpit.physics.contact.contact_model import Impulses
+from ballpit.physics.contact.rows import ContactRows
+from ballpit.physics.core.settings import JACOBI_FROM, JACOBI_SWEEPS
 
 G, DT, R, M = 9.81, 1 / 240, 0.5, 2.0
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
+from ballpit.physics.core.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
 
 G = 9.81
 RATES = [60, 240]
@@ -160,7 +160,7 @@ def test_kept_pairs_of_still_planes_are_the_pairs_found_afresh_while_another_pla
     # plane's again gives, in the same order, also for a plane that has just stopped.
     import copy
 
-    from ballpit.physics.pairs import plane_pairs, refresh_moving
+    from ballpit.physics.collision.pairs import plane_pairs, refresh_moving
 
     dt = 1 / 240
     world = ballpit.World()
@@ -192,7 +192,8 @@ def test_kept_pairs_of_still_planes_are_the_pairs_found_afresh_while_another_pla
 def test_a_turning_plane_is_moved_as_the_quaternion_functions_move_it_bit_for_bit():
     # advance works each plane in Python floats; its pose must be the one quaternion.from_axis_angle,
     # multiply, normalize and rotate give (exact.norm for the normal), to the last bit.
-    from ballpit.physics import exact, moving_planes, quaternion
+    from ballpit.physics.core import exact, quaternion
+    from ballpit.physics.dynamics import moving_planes
 
     rng = np.random.default_rng(4)
     world = ballpit.World()

@@ -4,7 +4,7 @@ proportion to its inverse mass, all contacts at once (``separate``) or colour by
 import numpy as np
 import pytest
 
-from ballpit.physics import penetration
+from ballpit.physics.contact import penetration
 
 from .test_jacobi import R, column
 

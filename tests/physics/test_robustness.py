@@ -188,7 +188,7 @@ def test_total_energy_never_rises_in_a_closed_elastic_box_under_gravity():
 
 def deepest_overlaps(world: ballpit.World) -> tuple[float, float]:
     """The deepest ball–ball overlap and the deepest ball–plane penetration, each in radii."""
-    from ballpit.physics import broadphase
+    from ballpit.physics.collision import broadphase
 
     x, r = world.spheres.positions, world.spheres.radii
     i, j = broadphase.sphere_pairs(x - r[:, None], x + r[:, None])

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.settings import SLEEP_SPEED, TIME_TO_SLEEP
-from ballpit.physics.sleeping import islands
+from ballpit.physics.core.settings import SLEEP_SPEED, TIME_TO_SLEEP
+from ballpit.physics.dynamics.sleeping import islands
 from ballpit.scene import read_scene, resolve_scene_path
 
 DT = 1 / 240

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.integrators import INTEGRATOR_NAMES
+from ballpit.physics.dynamics.integrators import INTEGRATOR_NAMES
 
 G = 9.81
 

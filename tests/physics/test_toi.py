@@ -8,7 +8,7 @@ import math
 import pytest
 
 import ballpit
-from ballpit.physics.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
+from ballpit.physics.core.settings import CONTACT_SLOP, PENETRATION_TOLERANCE
 
 G = 9.81
 

@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import ballpit
-from ballpit.physics import steppable
+from ballpit.physics.core import steppable
 
 
 def test_views_read_and_write_the_world_arrays():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ballpit.physics.integrators import INTEGRATORS
+from ballpit.physics.dynamics.integrators import INTEGRATORS
 from ballpit.viewer import controls
 from ballpit.viewer.controls import Action, IntegratorAction, action_for_key
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import colorsys
 import itertools
 
-from ballpit.physics.integrators import INTEGRATORS
+from ballpit.physics.dynamics.integrators import INTEGRATORS
 from ballpit.viewer.energyplot import KINETIC_COLOR, POTENTIAL_COLOR
 
 

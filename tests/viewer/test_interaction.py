@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ballpit
-from ballpit.physics.contacts import KIND_NAMES
+from ballpit.physics.core.contacts import KIND_NAMES
 from ballpit.scene import read_scene
 from ballpit.viewer.camera import Camera
 from ballpit.viewer.interaction import SHOT_SPEEDS, TILT_RATE, Interaction, typical_material

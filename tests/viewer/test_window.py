@@ -251,7 +251,7 @@ def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
 
 
 def test_f2_shows_the_time_of_each_stage_of_the_step_and_f2_again_goes_back(xvfb, tmp_path):
-    from ballpit.physics.profile import STAGES
+    from ballpit.physics.core.profile import STAGES
 
     result = run_scenario(xvfb, "profile_page", tmp_path)
     text = result["profile"]

@@ -46,7 +46,7 @@ def _add_run_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser for every command (``bench`` passes its arguments straight through)."""
-    from ..physics.integrators import INTEGRATOR_NAMES, INTEGRATORS
+    from ..physics.dynamics.integrators import INTEGRATOR_NAMES, INTEGRATORS
 
     labels = [integrator.label for integrator in INTEGRATORS.values()]
     integrator_labels = ", ".join(labels[:-1]) + " and " + labels[-1]  # "Euler, RK2, RK4 and ..."
@@ -191,7 +191,7 @@ class StepTotals:
     on to another observer (the energy plot) if there is one."""
 
     def __init__(self, then: Callable[[World], None] | None) -> None:
-        from ..physics.profile import RunProfile
+        from ..physics.core.profile import RunProfile
 
         self.totals = RunProfile()
         self.then = then

@@ -19,7 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ..physics import World
-from ..physics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
+from ..physics.dynamics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .simulate import progress_bar, step_longer_than_run, step_plan
 

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..physics.integrators import INTEGRATORS
+from ..physics.dynamics.integrators import INTEGRATORS
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .writers import AtomicFile, OutputError
 

@@ -15,8 +15,8 @@ import numpy as np
 from tqdm import tqdm
 
 from ..physics import DEFAULT_TIMESTEP, Contacts, World
-from ..physics.contacts import SPHERE_PLANE, SPHERE_SPHERE
-from ..physics.validation import MAX_TIMESTEP
+from ..physics.core.contacts import SPHERE_PLANE, SPHERE_SPHERE
+from ..physics.core.validation import MAX_TIMESTEP
 from .trajectory import TrajectoryWriter
 from .writers import EventWriter
 

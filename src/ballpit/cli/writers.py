@@ -24,7 +24,7 @@ from typing import IO
 import numpy as np
 
 from ..physics import Contacts
-from ..physics.contacts import KIND_NAMES
+from ..physics.core.contacts import KIND_NAMES
 
 EVENT_COLUMNS = ("time", "kind", "a", "b", "x", "y", "z", "nx", "ny", "nz", "impulse")
 FORMATS = (".csv", ".npz")

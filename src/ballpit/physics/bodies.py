@@ -14,9 +14,10 @@ from typing import Protocol, overload
 
 import numpy as np
 
-from . import collision, exact, steppable, validation
-from .model import Model
-from .state import Columns, Q, State, V, W, X
+from .collision import geometry
+from .core import exact, steppable, validation
+from .core.state import Columns, Q, State, V, W, X
+from .dynamics.model import Model
 
 
 class Viewed(Protocol):
@@ -240,7 +241,7 @@ class Plane(_Body):
         flat = p.reshape(-1, 3)
         center, _normal, u, v, half = self._frame()
         zeros = np.zeros(len(flat), dtype=np.intp)
-        closest = collision.closest_point_on_planes(flat, zeros, center, u, v, half)
+        closest = geometry.closest_point_on_planes(flat, zeros, center, u, v, half)
         return closest.reshape(p.shape)
 
     def distance(self, points: object) -> np.ndarray | float:

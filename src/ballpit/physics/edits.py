@@ -7,12 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import collision, exact, moving_planes, quaternion, validation
-from .checkpoint import Parts
-from .model import HOLLOW_INERTIA, SOLID_INERTIA, Model
-from .pairs import PairCache
-from .resting import WarmStart
-from .state import State, X
+from .collision import geometry
+from .collision.pairs import PairCache
+from .contact.resting import WarmStart
+from .core import exact, quaternion, validation
+from .core.state import State, X
+from .dynamics import moving_planes
+from .dynamics.model import HOLLOW_INERTIA, SOLID_INERTIA, Model
+from .step.checkpoint import Parts
 
 
 def index_of(kind: str, index: object, count: int) -> int:
@@ -77,9 +79,7 @@ def first_overlap(model: Model, state: State, position: object, radius: float) -
     pose, shape = state.planes, model.planes
     k = np.arange(shape.count)
     points = np.broadcast_to(p, (shape.count, 3))
-    near = collision.closest_point_on_planes(
-        points, k, pose.center, pose.axis_u, pose.axis_v, shape.half_size
-    )
+    near = geometry.closest_point_on_planes(points, k, pose.center, pose.axis_u, pose.axis_v, shape.half_size)
     gap = near - points
     hit = np.flatnonzero(exact.dot_rows(gap, gap) < r * r)
     return f"plane {hit[0]}" if hit.size else None

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact
-from .model import Model
-from .state import State, V, W, X
+from .core import exact
+from .core.state import State, V, W, X
+from .dynamics.model import Model
 
 
 def kinetic(model: Model, state: State) -> float:

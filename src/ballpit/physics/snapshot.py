@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .checkpoint import Checkpoint
-from .model import Model
-from .state import SavedState
+from .core.state import SavedState
+from .dynamics.model import Model
+from .step.checkpoint import Checkpoint
 
 
 @dataclass(frozen=True)

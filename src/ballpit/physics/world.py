@@ -12,14 +12,17 @@ import copy
 
 import numpy as np
 
-from . import edits, energy, moving_planes, steppable, validation
+from . import edits, energy
 from . import step as pipeline
 from .bodies import Plane, PlaneList, Sphere, SphereList
-from .checkpoint import Checkpoint, Parts
-from .contacts import ContactRecord
-from .forces import ForceTerm
-from .integrators import Workspace
-from .model import (
+from .core import steppable, validation
+from .core.contacts import ContactRecord
+from .core.profile import StepProfile
+from .core.state import Q, State, V, W, X
+from .dynamics import moving_planes
+from .dynamics.forces import ForceTerm
+from .dynamics.integrators import Workspace
+from .dynamics.model import (
     BALL_MASS,
     BALL_RADIUS,
     BALL_RESTITUTION,
@@ -28,10 +31,9 @@ from .model import (
     ROLLING_FRICTION,
     Model,
 )
-from .parameters import Count, Flag, Integrator, Number, Vector
-from .profile import StepProfile
+from .dynamics.parameters import Count, Flag, Integrator, Number, Vector
 from .snapshot import Snapshot
-from .state import Q, State, V, W, X
+from .step.checkpoint import Checkpoint, Parts
 
 
 class World:

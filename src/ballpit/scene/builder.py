@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..physics import World, exact
+from ..physics import World
+from ..physics.core import exact
 from . import layout, schema
 from .appearance import Appearance, Scene, default_plane_colors, frame_camera, frozen
 from .balls import Balls

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..physics.broadphase import sphere_pairs
+from ..physics.collision.broadphase import sphere_pairs
 
 CROWD = 64  # balls in one broad-phase cell beyond which the cell is checked on its own first
 CROWD_SAMPLE = 256  # how many of a crowd's balls (the first, by index) that check compares

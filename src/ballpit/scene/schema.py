@@ -11,8 +11,9 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 
-from ..physics import DEFAULT_TIMESTEP, INTEGRATOR_NAMES, World, validation
-from ..physics.settings import OVERLAP_TOLERANCE as OVERLAP_TOLERANCE  # [world] overlap_tolerance
+from ..physics import DEFAULT_TIMESTEP, INTEGRATOR_NAMES, World
+from ..physics.core import validation
+from ..physics.core.settings import OVERLAP_TOLERANCE as OVERLAP_TOLERANCE
 
 
 def _defaults(function: Callable, names: tuple[str, ...]) -> dict[str, object]:

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..physics.integrators import INTEGRATORS
+from ..physics.dynamics.integrators import INTEGRATORS
 
 
 class Action(Enum):

@@ -88,7 +88,7 @@ def set_world(sim: Simulation, name: str, value: object) -> None:
         sim.time_scale = scale
         return
     if name == "timestep":
-        from ballpit.physics import validation
+        from ballpit.physics.core import validation
 
         timestep = validation.number("timestep", value, positive=True, within=(1e-5, 0.1))
         sim.scene = dataclasses.replace(sim.scene, timestep=timestep)

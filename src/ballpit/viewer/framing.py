@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..physics import quaternion
+from ..physics.core import quaternion
 from .camera import Camera
 
 if TYPE_CHECKING:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ..physics.integrators import INTEGRATORS as REGISTRY
+from ..physics.dynamics.integrators import INTEGRATORS as REGISTRY
 from .history import History
 
 INTEGRATORS = tuple(REGISTRY)

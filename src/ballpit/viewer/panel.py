@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from imgui_bundle import ImVec2, ImVec4, imgui, implot
 
-from ..physics.integrators import INTEGRATORS
+from ..physics.dynamics.integrators import INTEGRATORS
 from ..scene import bundled_scenes
 from . import actions
 from .controls import Action, IntegratorAction

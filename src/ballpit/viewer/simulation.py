@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..cli.trajectory import Trajectory
-from ..physics.profile import RunProfile
+from ..physics.core.profile import RunProfile
 from ..scene import Appearance, Scene, read_scene, scene_of
 from ..scene.colours import palette_colors
 from .timeline import Timeline

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from ..physics.contacts import SPHERE_SPHERE
-from ..physics.profile import STAGES
+from ..physics.core.contacts import SPHERE_SPHERE
+from ..physics.core.profile import STAGES
 from .save import euler_xyz_degrees
 from .simulation import Phase, Simulation
 

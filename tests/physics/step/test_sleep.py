@@ -4,9 +4,9 @@ measuring again, and returns what it measured; ``settle`` puts still islands to 
 from __future__ import annotations
 
 import ballpit
-from ballpit.physics.checkpoint import Checkpoint
-from ballpit.physics.settings import TIME_TO_SLEEP
+from ballpit.physics.core.settings import TIME_TO_SLEEP
 from ballpit.physics.step import plan, settle, solve, wake
+from ballpit.physics.step.checkpoint import Checkpoint
 
 from .stages import prepared
 

@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from ballpit.physics.checkpoint import Checkpoint
-from ballpit.physics.settings import RETRIES
+from ballpit.physics.core.settings import RETRIES
 from ballpit.physics.step import soft
+from ballpit.physics.step.checkpoint import Checkpoint
 from ballpit.physics.step.collide import Motion, collide
 from ballpit.physics.step.plan import Plan
 

@@ -10,9 +10,9 @@ import pytest
 
 import ballpit
 from ballpit.physics import step as pipeline
-from ballpit.physics.integrators import INTEGRATOR_NAMES
-from ballpit.physics.profile import StepProfile
-from ballpit.physics.settings import CONTACT_SLOP, MAX_INTERVALS
+from ballpit.physics.core.profile import StepProfile
+from ballpit.physics.core.settings import CONTACT_SLOP, MAX_INTERVALS
+from ballpit.physics.dynamics.integrators import INTEGRATOR_NAMES
 
 G = 9.81
 

@@ -24,13 +24,13 @@ from __future__ import annotations
 
 from time import perf_counter
 
-from .. import steppable, validation
-from ..checkpoint import Checkpoint, Parts
-from ..contacts import ContactRecord, EventLog
-from ..integrators import Workspace
-from ..model import Model
-from ..profile import StepProfile
+from ..core import steppable, validation
+from ..core.contacts import ContactRecord, EventLog
+from ..core.profile import StepProfile
+from ..dynamics.integrators import Workspace
+from ..dynamics.model import Model
 from . import soft, split
+from .checkpoint import Checkpoint, Parts
 from .collide import measure
 from .context import Step
 from .plan import Plan, Strategy, plan

@@ -6,13 +6,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import narrowphase, sleeping
-from ..contacts import ContactPoints
-from ..forces import ForceTerm, free_acceleration
-from ..model import Model
-from ..pairs import KeptPairs
-from ..profile import Stage
-from ..state import State
+from ..collision import narrowphase
+from ..collision.pairs import KeptPairs
+from ..core.contacts import ContactPoints
+from ..core.profile import Stage
+from ..core.state import State
+from ..dynamics import sleeping
+from ..dynamics.forces import ForceTerm, free_acceleration
+from ..dynamics.model import Model
 from .context import Step
 
 

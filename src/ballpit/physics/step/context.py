@@ -4,17 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from .. import moving_planes
-from ..checkpoint import Parts
-from ..contacts import EventLog
-from ..forces import ForceTerm
-from ..integrators import Workspace, integrate
-from ..model import Model
-from ..pairs import PairCache
-from ..profile import Stage, StepProfile
-from ..resting import WarmStart
-from ..state import State
-from ..steppable import PlanesAsStepped
+from ..collision.pairs import PairCache
+from ..contact.resting import WarmStart
+from ..core.contacts import EventLog
+from ..core.profile import Stage, StepProfile
+from ..core.state import State
+from ..core.steppable import PlanesAsStepped
+from ..dynamics import moving_planes
+from ..dynamics.forces import ForceTerm
+from ..dynamics.integrators import Workspace, integrate
+from ..dynamics.model import Model
+from .checkpoint import Parts
 
 
 @dataclass

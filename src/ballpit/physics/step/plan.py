@@ -13,11 +13,11 @@ from enum import Enum
 
 import numpy as np
 
-from .. import moving_planes
-from ..contacts import SPHERE_PLANE, ContactPoints
-from ..profile import Stage
-from ..settings import CROWD_OVERLAP, CROWD_PAIRS, SPECULATIVE_REACH
-from ..state import V, with_static
+from ..core.contacts import SPHERE_PLANE, ContactPoints
+from ..core.profile import Stage
+from ..core.settings import CROWD_OVERLAP, CROWD_PAIRS, SPECULATIVE_REACH
+from ..core.state import V, with_static
+from ..dynamics import moving_planes
 from .collide import Collision, Motion
 from .context import Step
 

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import sleeping
-from ..profile import Stage
+from ..core.profile import Stage
+from ..dynamics import sleeping
 from .collide import Collision, Motion, collide
 from .context import Step
 from .plan import speculative_reach

@@ -10,21 +10,18 @@ from enum import Enum
 
 import numpy as np
 
-from .. import collision, energy_guard, exact, moving_planes, narrowphase, softstep
-from ..checkpoint import Checkpoint
-from ..contacts import SPHERE_PLANE, ContactPoints
-from ..forces import forces_of, free_acceleration
-from ..integrators import integrate
-from ..model import Model
-from ..profile import Stage
-from ..settings import (
-    BROAD_PHASE_STEPS,
-    DEEP_OVERLAP,
-    RETRIES,
-    SPECULATIVE_REACH,
-    SUBSTEP_TRAVEL,
-)
-from ..state import State, V, X
+from ..collision import geometry, narrowphase
+from ..contact import energy_guard, softstep
+from ..core import exact
+from ..core.contacts import SPHERE_PLANE, ContactPoints
+from ..core.profile import Stage
+from ..core.settings import BROAD_PHASE_STEPS, DEEP_OVERLAP, RETRIES, SPECULATIVE_REACH, SUBSTEP_TRAVEL
+from ..core.state import State, V, X
+from ..dynamics import moving_planes
+from ..dynamics.forces import forces_of, free_acceleration
+from ..dynamics.integrators import integrate
+from ..dynamics.model import Model
+from .checkpoint import Checkpoint
 from .collide import Collision, Motion
 from .context import Step
 from .plan import Plan
@@ -218,9 +215,9 @@ def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) 
         d = before[s, 0:3] - pose.center[p]
         nrm = pose.normal[p]
         side = np.where(exact.dot_rows(d, nrm) < 0.0, -1.0, 1.0)
-        gap[on_plane] = collision.sphere_plane(
+        gap[on_plane] = geometry.sphere_plane(
             x, radius, s, p, side, pose.center, pose.normal, pose.axis_u, pose.axis_v, model.planes.half_size
         )[0]
     if (~on_plane).any():
-        gap[~on_plane] = collision.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
+        gap[~on_plane] = geometry.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
     return gap

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import impacts, narrowphase, penetration, resting, rows, toi
-from ..contacts import ContactPoints
-from ..forces import ConstantPerBall, free_acceleration
-from ..pairs import KeptPairs
-from ..profile import Stage
-from ..settings import BROAD_PHASE_STEPS, MAX_INTERVALS
-from ..state import V, W
+from ..collision import narrowphase, toi
+from ..collision.pairs import KeptPairs
+from ..contact import impacts, penetration, resting, rows
+from ..core.contacts import ContactPoints
+from ..core.profile import Stage
+from ..core.settings import BROAD_PHASE_STEPS, MAX_INTERVALS
+from ..core.state import V, W
+from ..dynamics.forces import ConstantPerBall, free_acceleration
 from .collide import Motion, measure
 from .context import Step, integrate_interval
 

@@ -14,11 +14,13 @@ from functools import cached_property
 
 import numpy as np
 
-from . import contact_model, exact, moving_planes
+from ..core import exact
+from ..core.contacts import SPHERE_PLANE, ContactPoints, take_indices
+from ..core.state import State
+from ..dynamics import moving_planes
+from ..dynamics.model import Model
+from . import contact_model
 from .contact_model import Impulses
-from .contacts import SPHERE_PLANE, ContactPoints, take_indices
-from .model import Model
-from .state import State
 
 
 @dataclass

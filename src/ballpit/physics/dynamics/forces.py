@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .state import Q, V, W, X
+from ..core.state import Q, V, W, X
 
 
 class ForceTerm(Protocol):

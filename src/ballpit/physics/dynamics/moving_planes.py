@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from . import exact, quaternion
+from ..core import exact, quaternion
+from ..core.state import Columns, State
 from .model import Model
-from .state import Columns, State
 
 
 def place(pose: Columns, i: int, center: np.ndarray, q: np.ndarray) -> None:

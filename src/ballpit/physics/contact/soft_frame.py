@@ -5,15 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, jacobi
+from ..core import exact
+from ..core.contacts import ContactPoints
+from ..core.settings import CONTACT_HERTZ, DAMPING_RATIO, PLANE_STIFFNESS, SOFT_RATE_CAP
+from ..core.state import Q, State, V, W, X
+from ..dynamics.forces import ForceTerm, constant_acceleration, forces_of
+from ..dynamics.model import Model
+from . import jacobi
 from .contact_model import softness
-from .contacts import ContactPoints
-from .forces import ForceTerm, constant_acceleration, forces_of
-from .model import Model
 from .resting import WarmStart
 from .rows import contact_rows
-from .settings import CONTACT_HERTZ, DAMPING_RATIO, PLANE_STIFFNESS, SOFT_RATE_CAP
-from .state import Q, State, V, W, X
 
 
 class SoftFrame:

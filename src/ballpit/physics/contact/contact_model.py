@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import exact
-from .settings import NO_ZERO_DIVIDE
+from ..core import exact
+from ..core.settings import NO_ZERO_DIVIDE
 
 
 @dataclass

@@ -26,12 +26,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import exact
+from ..core.settings import ADD_UP_BINS_UP_TO, CONVERGED
 from . import contact_model as model
-from . import exact
 from .contact_model import Impulses
 from .ends import Ends
 from .rows import ContactRows
-from .settings import ADD_UP_BINS_UP_TO, CONVERGED
 
 
 class ContactColumns(Ends):

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .settings import RK4_CHUNK
-from .state import Q
-from .workspace import Workspace
+from ..core.settings import RK4_CHUNK
+from ..core.state import Q
+from ..core.workspace import Workspace
 
 # The fast path's layout of a chunk, one ball per column: x, v, then q with its y and z repeated in
 # front (qy qz qx qy qz qw) and ω with its x and y repeated behind (ωx ωy ωz ωx ωy), so the rotated

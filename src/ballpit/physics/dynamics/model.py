@@ -9,10 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact
-from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
-from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
-from .settings import (
+from ..core import exact
+from ..core.settings import (
     CONTACT_SLOP,
     CROWD_LIMIT,
     SLOP_PER_RADIUS,
@@ -20,7 +18,9 @@ from .settings import (
     SOLVER_ITERATIONS,
     EnergyGuards,
 )
-from .state import Columns
+from ..core.state import Columns
+from .forces import AngularDrag, ForceTerm, Gravity, LinearDrag
+from .integrators import DEFAULT_INTEGRATOR, INTEGRATORS, Integrator
 
 # Moments of inertia of a sphere about a diameter, as a fraction of m·r².
 SOLID_INERTIA = 2.0 / 5.0

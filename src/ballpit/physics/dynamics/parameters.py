@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import validation
+from ..core import validation
 from .integrators import INTEGRATORS
 
 

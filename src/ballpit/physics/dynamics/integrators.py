@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import quaternion
+from ..core import quaternion
+from ..core.state import Q, V, W, X
+from ..core.workspace import Workspace
 from .forces import ForceTerm, constant_acceleration
 from .rk4_fast import rk4_constant
-from .state import Q, V, W, X
-from .workspace import Workspace
 
 
 def derivative(state: np.ndarray, forces: Sequence[ForceTerm], out: np.ndarray) -> np.ndarray:

@@ -1,7 +1,7 @@
 """Narrow phase: every kept pair measured at the current positions (gap, normal and point).
 
 The geometry itself (sphere–rectangle with faces, edges and corners; sphere–sphere) is in
-``collision.py``; this stage gathers it for the kept pairs into one ``ContactPoints``, sphere–plane
+``geometry.py``; this stage gathers it for the kept pairs into one ``ContactPoints``, sphere–plane
 pairs first. A plane's contacts name the static row N as their second body, so the solver treats a
 plane as a ball that never moves.
 """
@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import collision
-from .contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints
-from .model import Model
+from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints
+from ..core.state import State, X
+from ..dynamics.model import Model
+from . import geometry
 from .pairs import KeptPairs
-from .state import State, X
 
 
 def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoints:
@@ -22,7 +22,7 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
     x, radius = state.body[:, X], model.spheres.radius
     c = pairs
     pose = state.planes
-    gp, np_, pp = collision.sphere_plane(
+    gp, np_, pp = geometry.sphere_plane(
         x,
         radius,
         c.sphere,
@@ -34,7 +34,7 @@ def contact_points(model: Model, state: State, pairs: KeptPairs) -> ContactPoint
         pose.axis_v,
         model.planes.half_size,
     )
-    gs, ns, ps = collision.sphere_sphere(x, radius, c.pair_i, c.pair_j)
+    gs, ns, ps = geometry.sphere_sphere(x, radius, c.pair_i, c.pair_j)
     static = np.full(len(c.sphere), model.spheres.count)
     kind = np.full(len(gp) + len(gs), SPHERE_SPHERE, np.int8)  # one byte a pair
     kind[: len(gp)] = SPHERE_PLANE

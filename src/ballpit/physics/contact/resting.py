@@ -12,13 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact, solver
-from .contact_model import Impulses
-from .contacts import ContactPoints, EventLog
-from .forces import ConstantPerBall
-from .model import Model
-from .rows import ContactRows, rows_at_end
-from .settings import (
+from ..core import exact
+from ..core.contacts import ContactPoints, EventLog
+from ..core.settings import (
     HELD_ALONG,
     HOLD_LAYERS,
     HOLD_PASSES,
@@ -27,7 +23,12 @@ from .settings import (
     NEW_DIRECTION,
     WARM_START_SPAN,
 )
-from .state import State, V, W, shallow_copy, with_static
+from ..core.state import State, V, W, shallow_copy, with_static
+from ..dynamics.forces import ConstantPerBall
+from ..dynamics.model import Model
+from . import solver
+from .contact_model import Impulses
+from .rows import ContactRows, rows_at_end
 
 
 class WarmStart:

@@ -15,17 +15,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import broadphase, exact, moving_planes
-from .integrators import Integrator
-from .model import Model
-from .settings import (
-    BROAD_PHASE_MARGIN,
-    BROAD_PHASE_REACH,
-    BROAD_PHASE_STEPS,
-    ESCAPE_CHUNK,
-    TINY,
-)
-from .state import State, V, X, shallow_copy
+from ..core import exact
+from ..core.settings import BROAD_PHASE_MARGIN, BROAD_PHASE_REACH, BROAD_PHASE_STEPS, ESCAPE_CHUNK, TINY
+from ..core.state import State, V, X, shallow_copy
+from ..dynamics import moving_planes
+from ..dynamics.integrators import Integrator
+from ..dynamics.model import Model
+from . import broadphase
 
 
 @dataclass

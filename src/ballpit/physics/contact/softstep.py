@@ -44,22 +44,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import exact, impacts, jacobi, quaternion, separate
+from ..core import exact, quaternion
+from ..core.contacts import ContactPoints
+from ..core.profile import Stage, StepProfile
+from ..core.settings import LEVEL, MAX_PUSH, PUSH_AHEAD, RELAX_SWEEPS, SOLVE_SWEEPS
+from ..core.state import Q, State, V, W, X
+from ..dynamics.forces import ForceTerm, column_accelerations
+from ..dynamics.model import Model
+from . import impacts, jacobi, separate
 from .contact_model import Impulses
-from .contacts import ContactPoints
-from .forces import ForceTerm, column_accelerations
-from .model import Model
-from .profile import Stage, StepProfile
 from .resting import WarmStart
-from .settings import (
-    LEVEL,
-    MAX_PUSH,
-    PUSH_AHEAD,
-    RELAX_SWEEPS,
-    SOLVE_SWEEPS,
-)
 from .soft_frame import SoftFrame
-from .state import Q, State, V, W, X
 
 
 @dataclass

@@ -27,10 +27,10 @@ import math
 
 import numpy as np
 
-from . import exact
-from .model import Model
+from ..core import exact
+from ..core.state import State, V, W, X
+from ..dynamics.model import Model
 from .rows import ContactRows
-from .state import State, V, W, X
 
 
 def keep_impulses(

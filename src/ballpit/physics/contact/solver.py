@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import exact
+from ..core.settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 from . import contact_model as model
-from . import exact, jacobi
+from . import jacobi
 from .contact_model import Impulses
 from .ends import Ends
 from .rows import ContactRows
-from .settings import CONVERGED, JACOBI_FRICTION_EVERY, JACOBI_FROM, JACOBI_SWEEPS
 
 
 class _Colour:

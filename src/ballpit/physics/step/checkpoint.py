@@ -18,9 +18,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
-from .pairs import PairCache
-from .resting import WarmStart
-from .state import SavedState, State
+from ..collision.pairs import PairCache
+from ..contact.resting import WarmStart
+from ..core.state import SavedState, State
 
 
 @dataclass

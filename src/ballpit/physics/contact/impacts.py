@@ -37,12 +37,8 @@ import dataclasses
 
 import numpy as np
 
-from . import contact_model, energy_guard, jacobi, resting, solver
-from .contact_model import Impulses
-from .contacts import ContactPoints, EventLog
-from .model import Model
-from .rows import ContactRows
-from .settings import (
+from ..core.contacts import ContactPoints, EventLog
+from ..core.settings import (
     APPROACH_SPEED,
     BOUNCE_HOPS,
     BOUNCE_JACOBI_SWEEPS,
@@ -53,7 +49,11 @@ from .settings import (
     WAVE_ITERATIONS,
     WAVE_SWEEPS,
 )
-from .state import State, V, W, with_static
+from ..core.state import State, V, W, with_static
+from ..dynamics.model import Model
+from . import contact_model, energy_guard, jacobi, resting, solver
+from .contact_model import Impulses
+from .rows import ContactRows
 
 
 def in_waves(

@@ -17,12 +17,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import energy_guard, exact, penetration
-from .model import Model
+from ..core import exact
+from ..core.settings import (
+    MAX_PUSH,
+    PENETRATION_TOLERANCE,
+    SEPARATE_REACH,
+    SEPARATE_SWEEPS,
+    SLOP,
+    SLOP_RETURN,
+)
+from ..core.state import State, X, with_static
+from ..dynamics.model import Model
+from . import energy_guard, penetration
 from .resting import WarmStart
-from .settings import MAX_PUSH, PENETRATION_TOLERANCE, SEPARATE_REACH, SEPARATE_SWEEPS, SLOP, SLOP_RETURN
 from .soft_frame import SoftFrame
-from .state import State, X, with_static
 
 
 def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:

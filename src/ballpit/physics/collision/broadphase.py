@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import exact
-from .settings import ALL_PAIRS_UP_TO, CELL_PER_MEDIAN_BOX, DENSE_CELLS_PER_BALL
+from ..core import exact
+from ..core.settings import ALL_PAIRS_UP_TO, CELL_PER_MEDIAN_BOX, DENSE_CELLS_PER_BALL
 
 # The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
 _OFFSETS = np.array(

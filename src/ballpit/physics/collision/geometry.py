@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .settings import TINY
+from ..core.settings import TINY
 
 
 def closest_point_on_planes(

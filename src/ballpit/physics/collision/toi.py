@@ -14,11 +14,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import collision, exact, moving_planes
-from .contacts import SPHERE_PLANE, ContactPoints
-from .model import Model
-from .settings import IMPACT_OVERLAP, LEAP_AFTER, MAX_ADVANCE_STEPS
-from .state import State, V, X, with_static
+from ..core import exact
+from ..core.contacts import SPHERE_PLANE, ContactPoints
+from ..core.settings import IMPACT_OVERLAP, LEAP_AFTER, MAX_ADVANCE_STEPS
+from ..core.state import State, V, X, with_static
+from ..dynamics import moving_planes
+from ..dynamics.model import Model
+from . import geometry
 
 
 def first_contact(
@@ -128,9 +130,9 @@ def meetings(
             if moving:  # each plane where it will be after t
                 centre, u, w = moving_planes.frames_at(model, state, pk, t[plane_k])
                 rows = np.arange(len(pk))
-                pb[plane_k] = collision.closest_point_on_planes(pa[plane_k], rows, centre, u, w, half[pk])
+                pb[plane_k] = geometry.closest_point_on_planes(pa[plane_k], rows, centre, u, w, half[pk])
             else:
-                pb[plane_k] = collision.closest_point_on_planes(
+                pb[plane_k] = geometry.closest_point_on_planes(
                     pa[plane_k], pk, pose.center, pose.axis_u, pose.axis_v, half
                 )
         return np.linalg.norm(pa - pb, axis=1) - reach[k]

@@ -11,13 +11,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import contact_model, energy_guard, exact
-from .contacts import ContactPoints
+from ..core import exact
+from ..core.contacts import ContactPoints
+from ..core.settings import (
+    HOLD_SINK,
+    JACOBI_FROM,
+    OVERLAP_PER_RADIUS,
+    PENETRATION_SWEEPS,
+    PENETRATION_TOLERANCE,
+)
+from ..core.state import State, X, with_static
+from ..dynamics.model import Model
+from . import contact_model, energy_guard
 from .ends import Ends
-from .model import Model
 from .rows import ContactRows
-from .settings import HOLD_SINK, JACOBI_FROM, OVERLAP_PER_RADIUS, PENETRATION_SWEEPS, PENETRATION_TOLERANCE
-from .state import State, X, with_static
 
 
 def remove_penetration(model: Model, state: State, c: ContactPoints, rows: ContactRows) -> bool:

@@ -23,11 +23,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contacts import SPHERE_SPHERE, ContactPoints
+from ..core.contacts import SPHERE_SPHERE, ContactPoints
+from ..core.settings import SLEEP_SPEED, TIME_TO_SLEEP
+from ..core.state import Q, Sleep, State, V, W, X
 from .forces import ConstantPerBall
 from .model import Model
-from .settings import SLEEP_SPEED, TIME_TO_SLEEP
-from .state import Q, Sleep, State, V, W, X
 
 
 def context(model: Model, state: State) -> tuple:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .settings import ADD_UP_BINS_UP_TO, SORT_ENDS_FROM
+from ..core.settings import ADD_UP_BINS_UP_TO, SORT_ENDS_FROM
 
 
 class Ends:
