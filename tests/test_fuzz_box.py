@@ -770,6 +770,17 @@ COINCIDENT_MIXED_MASSES = Turned(
     steps=20,
 )
 
+# The same search (seed 302, shrunk): 40 balls of 6.25 cm and 1 kg at rest at the centre of the same
+# box, RK2 at 1/60 s: in step 14, taken whole (crowded), the energy rises by 28.6 J (of 785 J), on
+# main too. Not fixed yet: kept as an expected failure.
+COINCIDENT_FORTY = replace(
+    COINCIDENT_MIXED_MASSES,
+    positions=(_Z,) * 40,
+    velocities=(_Z,) * 40,
+    radii=(0.0625,) * 40,
+    masses=(1.0,) * 40,
+)
+
 
 def check_turned_box(box: Turned) -> None:
     """Run ``box``: after every step no state is non-finite, no ball's centre is beyond a wall, and an
@@ -815,6 +826,7 @@ def test_no_ball_pressed_into_an_edge_or_corner_leaves_a_turned_box(box):
 
 @WIDE
 @example(COINCIDENT_MIXED_MASSES).xfail(raises=AssertionError, reason="energy rises by 3.07 J in step 7")
+@example(COINCIDENT_FORTY).xfail(raises=AssertionError, reason="energy rises by 28.6 J in step 14")
 @given(fast_in_turned_squares())
 def test_no_ball_at_a_thousand_metres_a_second_leaves_a_turned_box_of_squares(box):
     check_turned_box(box)
