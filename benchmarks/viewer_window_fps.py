@@ -27,6 +27,8 @@ Per scene, medians over the runs of:
   ``panel_cpu_ms_*`` the same in the window thread's CPU time (without the waits for the GIL and for a
   core that the wall time holds while the physics thread runs).
   ``--panel off`` opens the viewer with the panel hidden (F4), for a paired comparison of frame rates.
+- ``--ghosts on`` presses G once the window is warm, before X: the three integrator ghosts drop with
+  the main run and are stepped and drawn beside it throughout.
 
 ``--env NAME=VALUE`` sets a variable for the child before anything loads (LP_NUM_THREADS, ...); the
 load average of the machine at the start is printed, since the two cores may be shared.
@@ -53,6 +55,7 @@ name, seconds, quality, escape = sys.argv[1], float(sys.argv[2]), sys.argv[3], s
 width, height, land = int(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
 video = float(sys.argv[8])
 panel = sys.argv[9] == "on"
+ghosts = sys.argv[10] == "on"
 path = default_scene_path().with_name(name + ".toml")
 viewer = Viewer(size=(width, height), scene_path=path, quality=quality, panel=panel)
 sim = viewer.sim
@@ -118,6 +121,8 @@ def tick(_dt):
     now = time.perf_counter()
     phase = state["phase"]
     if phase == "warm" and now >= state["at"]:
+        if ghosts:  # G before X: the ghosts drop with the main run
+            viewer.window.dispatch_event("on_key_press", key.G, 0)
         state.update(phase="before", at=now + seconds, mark=mark())
     elif phase == "before" and now >= state["at"]:
         frames, _, t = state["mark"]
@@ -228,7 +233,7 @@ def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: di
     command = [sys.executable, "-c", CHILD, scene, str(args.seconds), args.quality,
                "1" if args.escape else "0", str(size[0]), str(size[1]), str(args.land),
                str(args.video)]  # fmt: skip
-    command.append(args.panel)
+    command += [args.panel, args.ghosts]
     if headless:
         command = [sys.executable, "-c", HEADLESS, scene, str(args.land)]
     proc = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
@@ -247,6 +252,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--size", default="1280x720", help="window size, WIDTHxHEIGHT")
     parser.add_argument("--quality", default="auto", help="auto, low or high (the viewer's option)")
     parser.add_argument("--panel", default="on", choices=("on", "off"), help="the panel shown or hidden")
+    parser.add_argument(
+        "--ghosts", default="off", choices=("on", "off"), help="the integrator ghosts (G) on before X"
+    )
     parser.add_argument("--escape", action="store_true", help="also time Esc, Esc in the middle of a step")
     parser.add_argument("--threads", action="store_true", help="CPU per kind of thread while it lands")
     parser.add_argument("--env", action="append", default=[], help="NAME=VALUE for the viewer process")
@@ -274,7 +282,8 @@ def main(argv: list[str] | None = None) -> int:
                 results[f"{scene} (headless)"].append(one_run(scene, args, size, env, headless=True))
     extra = f", {' '.join(args.env)}" if args.env else ""
     print(f"{time.strftime('%Y-%m-%d %H:%M')}, {size[0]}x{size[1]}, medians of {args.runs} runs, "
-          f"quality {args.quality}, panel {args.panel}{extra}, load average {load} at the start")  # fmt: skip
+          f"quality {args.quality}, panel {args.panel}, ghosts {args.ghosts}{extra}, "
+          f"load average {load} at the start")  # fmt: skip
     cols = COLUMNS + (THREAD_COLUMNS if args.threads else []) + (["escape_seconds"] if args.escape else [])
     cols += VIDEO_COLUMNS if args.video else []
     print("| scene | " + " | ".join(cols) + " |\n|---|" + "---|" * len(cols))

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import exact
-from ..core.settings import ALL_PAIRS_UP_TO, CELL_PER_MEDIAN_BOX, DENSE_CELLS_PER_BALL
+from ..core.settings import ALL_PAIRS_UP_TO, CELL_PER_MEDIAN_BOX, DENSE_CELLS_PER_BALL, PLANE_PAIRS_AT_ONCE
 
 # The cell and its 13 "forward" neighbours: every unordered pair of neighbouring cells once.
 _OFFSETS = np.array(
@@ -69,7 +69,7 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
         empty = np.zeros(0, np.intp)
         return empty, empty
     if n <= ALL_PAIRS_UP_TO:  # a handful of balls: every pair in one go, already in order
-        i, j = np.triu_indices(n, 1)
+        i, j = _every_pair(n)
         hit = _overlap(lo, hi, i, j)
         return i[hit], j[hit]
     # the largest side of each box, axis by axis on columns (a max is exact, in any order)
@@ -113,6 +113,20 @@ def sphere_pairs(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     key.sort()
     first = key // n
     return first.astype(np.intp), (key - first * n).astype(np.intp)
+
+
+# Every pair (i < j) of n boxes, by n (np.triu_indices, read only): made once for each small n.
+_EVERY_PAIR: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _every_pair(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(n, 1)``, kept (it costs a dozen NumPy calls, more than the test it feeds)."""
+    pairs = _EVERY_PAIR.get(n)
+    if pairs is None:
+        i, j = np.triu_indices(n, 1)
+        i.flags.writeable = j.flags.writeable = False
+        pairs = _EVERY_PAIR[n] = (i, j)
+    return pairs
 
 
 def _neighbour_steps(dims: np.ndarray) -> np.ndarray:
@@ -207,22 +221,29 @@ def sphere_plane_pairs(
         empty = np.zeros(0, np.intp)
         return empty, empty
     box_center = 0.5 * (lo + hi)
-    box_radius = 0.5 * np.linalg.norm(hi - lo, axis=1)
+    box_radius = 0.5 * exact.norm_rows(hi - lo)
+    chosen = np.arange(len(center)) if only is None else np.asarray(only, np.intp)
+    group = max(1, PLANE_PAIRS_AT_ONCE // max(len(lo), 1))  # planes per pass
     spheres, planes = [], []
-    for p in range(len(center)) if only is None else only.tolist():
-        d = box_center - center[p]
-        du = np.abs(exact.dot_rows(d, axis_u[p])) - half_size[p, 0]
-        dv = np.abs(exact.dot_rows(d, axis_v[p])) - half_size[p, 1]
-        dn = exact.dot_rows(d, normal[p])
+    for first in range(0, len(chosen), group):
+        ps = chosen[first : first + group]
+        # (planes, balls) at once: the same elementwise operations for each pair as one plane at a time
+        d = box_center[None, :, :] - center[ps][:, None, :]
+        du = np.abs(exact.dot_rows(d, axis_u[ps][:, None, :])) - half_size[ps, 0][:, None]
+        dv = np.abs(exact.dot_rows(d, axis_v[ps][:, None, :])) - half_size[ps, 1][:, None]
+        dn = exact.dot_rows(d, normal[ps][:, None, :])
         # distance from the box centre to the rectangle, against the box's bounding-sphere radius
         dist2 = np.maximum(du, 0.0) ** 2 + np.maximum(dv, 0.0) ** 2 + dn**2
         if sweep is None:
-            hit = np.flatnonzero(dist2 <= box_radius**2)
+            hit = dist2 <= box_radius**2
         else:
-            grown = box_radius + sweep(p, np.linalg.norm(d, axis=1) + box_radius)
-            hit = np.flatnonzero(dist2 <= grown**2)
-        spheres.append(hit)
-        planes.append(np.full(len(hit), p))
+            hit = np.empty(dist2.shape, bool)
+            for row, p in enumerate(ps.tolist()):
+                grown = box_radius + sweep(p, exact.norm_rows(d[row]) + box_radius)
+                hit[row] = dist2[row] <= grown**2
+        row, ball = hit.nonzero()  # plane by plane, each plane's balls in order
+        spheres.append(ball)
+        planes.append(ps[row])
     if not spheres:
         empty = np.zeros(0, np.intp)
         return empty, empty

@@ -26,8 +26,11 @@ def closest_point_on_planes(
     u = axis_u[plane]
     v = axis_v[plane]
     d = points - c
-    du = np.clip(np.einsum("ij,ij->i", d, u), -half_size[plane, 0], half_size[plane, 0])
-    dv = np.clip(np.einsum("ij,ij->i", d, v), -half_size[plane, 1], half_size[plane, 1])
+    # clamped as np.clip does (its bounds are never zero, so no sign of zero can differ), without its
+    # wrapper's cost
+    du_max, dv_max = half_size[plane, 0], half_size[plane, 1]
+    du = np.minimum(np.maximum(np.einsum("ij,ij->i", d, u), -du_max), du_max)
+    dv = np.minimum(np.maximum(np.einsum("ij,ij->i", d, v), -dv_max), dv_max)
     return c + du[:, None] * u + dv[:, None] * v
 
 
@@ -50,7 +53,7 @@ def sphere_plane(
     crossed the face (which continuous detection prevents, but an edited scene can cause) is pushed back
     to the side it came from instead of through.
     """
-    p = np.take(x, sphere, axis=0)  # rows by index: several times faster than x[sphere]
+    p = x.take(sphere, axis=0)  # rows by index: several times faster than x[sphere]
     point = closest_point_on_planes(p, plane, center, axis_u, axis_v, half_size)
     delta = p - point
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
@@ -69,12 +72,14 @@ def sphere_sphere(
     x: np.ndarray, radius: np.ndarray, i: np.ndarray, j: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap, unit normal (from j towards i) and contact point (middle of the gap) for each pair."""
-    xj = np.take(x, j, axis=0)  # rows by index: several times faster than x[j]
-    delta = np.take(x, i, axis=0) - xj
+    xj = x.take(j, axis=0)  # rows by index: several times faster than x[j]
+    delta = x.take(i, axis=0) - xj
     dist = np.sqrt(np.einsum("ij,ij->i", delta, delta))
     coincident = dist <= TINY
     normal = delta / np.maximum(dist, TINY)[:, None]
-    if coincident.any():  # coincident centres have no normal; pick +y so the pair separates vertically
+    if np.count_nonzero(
+        coincident
+    ):  # coincident centres have no normal: +y, so the pair separates vertically
         normal[coincident] = (0.0, 1.0, 0.0)
     rj = radius[j]
     gap = dist - radius[i] - rj

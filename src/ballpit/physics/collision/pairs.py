@@ -75,17 +75,17 @@ class KeptPairs:
             self._columns = tuple(np.ascontiguousarray(a.T) for a in (self.lo, self.hi, self.centre))
         lo, hi, centre = self._columns
         n = len(body)
-        if n and (accel == accel[0]).all():
+        if n and not np.count_nonzero(accel != accel[0]):
             # One acceleration for all (gravity, drag-free flight): a single column. A row that differs
             # from the first only in the sign of a zero moves ``end`` by a signed zero at most, which
             # none of the comparisons below can tell apart.
             accel = accel[:1]
-        pad = radius + path.sag(np.linalg.norm(accel, axis=1), h)
+        pad = radius + path.sag(exact.norm_rows(accel), h)
         lift = path.path_offset(accel, h).T  # ½h²·b: the path's bend (0 if straight)
         shared = lift.shape[1] == 1
         size = min(n, ESCAPE_CHUNK)
-        x, end, d, e = (np.empty((3, size)) for _ in range(4))
-        far, tmp = np.empty(size), np.empty(size)
+        x, end, d, e = np.empty((4, 3, size))  # scratch, one allocation
+        far, tmp = np.empty((2, size))
         for start in range(0, n, ESCAPE_CHUNK):
             rows = slice(start, start + ESCAPE_CHUNK)
             m = min(ESCAPE_CHUNK, n - start)
@@ -98,11 +98,11 @@ class KeptPairs:
             # the box around the chord, grown by pad, inside the kept box
             np.minimum(xs, ends, out=ds)
             ds -= pads
-            if np.any(ds < lo[:, rows]):
+            if np.count_nonzero(ds < lo[:, rows]):
                 return True
             np.maximum(xs, ends, out=ds)
             ds += pads
-            if np.any(ds > hi[:, rows]):
+            if np.count_nonzero(ds > hi[:, rows]):
                 return True
             # the chord's ends inside the sphere keep the whole chord inside (spheres are convex)
             np.subtract(xs, centre[:, rows], out=ds)
@@ -111,7 +111,7 @@ class KeptPairs:
             exact.norm_cols(ds, es, tmps)
             np.maximum(fars, tmps, out=fars)
             fars += pads
-            if np.any(fars > self.reach[rows]):
+            if np.count_nonzero(fars > self.reach[rows]):
                 return True
         return False
 

@@ -43,7 +43,7 @@ def first_contact(
     count = len(speed_bound)
     t = np.zeros(count)
     when = np.full(count, np.inf)
-    active = np.arange(count) if start is None else np.flatnonzero(start <= t_max)
+    active = np.arange(count) if start is None else (start <= t_max).nonzero()[0]
     if active.size == 0:
         return when
     gap = gap_at(active, t[active])
@@ -78,7 +78,7 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     slop = model.contact_slop()
     when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop)
     hit = np.isfinite(when)
-    if not hit.any():
+    if not np.count_nonzero(hit):
         return np.inf
     order = np.argsort(when[hit], kind="stable")
     t, speed = when[hit][order], bound[hit][order]
@@ -93,7 +93,7 @@ def meetings(
     """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
     ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
     all (their indices into ``c``)."""
-    apart = np.flatnonzero(c.gap >= model.contact_slop())
+    apart = (c.gap >= model.contact_slop()).nonzero()[0]
     none = np.zeros(0)
     if apart.size == 0:
         return none, none, apart
@@ -125,7 +125,7 @@ def meetings(
         pa = path.position_at(x[a[k]], v[a[k]], accel[a[k]], tt)
         pb = path.position_at(x[b[k]], v[b[k]], accel[b[k]], tt)
         plane_k = on_plane[k]
-        if plane_k.any():
+        if np.count_nonzero(plane_k):
             pk = c.other[apart[k[plane_k]]]
             if moving:  # each plane where it will be after t
                 centre, u, w = moving_planes.frames_at(model, state, pk, t[plane_k])
@@ -135,7 +135,7 @@ def meetings(
                 pb[plane_k] = geometry.closest_point_on_planes(
                     pa[plane_k], pk, pose.center, pose.axis_u, pose.axis_v, half
                 )
-        return np.linalg.norm(pa - pb, axis=1) - reach[k]
+        return exact.norm_rows(pa - pb) - reach[k]
 
     start = earliest(model, state, c, apart, x, v, acc, h, goal)
     return first_contact(gap_at, bound, h, goal, start=start), bound, apart
@@ -173,7 +173,7 @@ def earliest(
     dv, da = v[a] - v[b], acc[a] - acc[b]
     slope, curve = exact.dot_rows(e, dv), exact.dot_rows(e, da)
     if model.moving_planes():
-        on = np.flatnonzero(c.kind[apart] == SPHERE_PLANE)
+        on = (c.kind[apart] == SPHERE_PLANE).nonzero()[0]
         pl, k = model.planes, c.other[apart[on]]
         spin, rel = model.plane_spin()[k], dv[on] - pl.velocity[k]  # v − v_p
         w = rel - exact.cross_rows(spin, x[a[on]] - state.planes.center[k])
@@ -196,11 +196,11 @@ def threatened(model: Model, state: State, c: ContactPoints, accel: np.ndarray, 
     bounded as in ``next_impact``). A (N,) mask."""
     n = model.spheres.count
     hit = np.zeros(n + 1, bool)
-    apart = np.flatnonzero(c.gap >= model.contact_slop())
+    apart = (c.gap >= model.contact_slop()).nonzero()[0]
     if apart.size:
         body, path = state.body, model.integrator
-        speed = np.append(np.linalg.norm(body[:, V], axis=1), 0.0)
-        acc = np.append(np.linalg.norm(path.path_acceleration(accel), axis=1), 0.0)
+        speed = np.append(exact.norm_rows(body[:, V]), 0.0)
+        acc = np.append(exact.norm_rows(path.path_acceleration(accel)), 0.0)
         a, b = c.a[apart], c.b[apart]
         bound = speed[a] + speed[b] + (acc[a] + acc[b]) * h
         if model.moving_planes():

@@ -4,6 +4,8 @@ and adds per-contact values back per ball."""
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from ..core.settings import ADD_UP_BINS_UP_TO, SORT_ENDS_FROM
@@ -23,11 +25,16 @@ class Ends:
         else:  # the same compact numbering (balls in increasing order) from a table over the world
             present = np.zeros(rows_in_world, bool)
             present[ab] = True
-            self.balls = np.flatnonzero(present)
+            self.balls = present.nonzero()[0]
             self.ends = np.take(np.cumsum(present) - 1, ab)
         self.m = len(self.balls)
-        self.share = np.bincount(self.ends, minlength=self.m).astype(float)
         self._flat: dict[int, np.ndarray] = {}  # add_up's bins for every entry, by number of rows
+
+    @cached_property
+    def share(self) -> np.ndarray:
+        """Each ball's number of contacts, as a float (made when first asked: a Gauss–Seidel solve
+        never asks)."""
+        return np.bincount(self.ends, minlength=self.m).astype(float)
 
     def add_up(self, values: np.ndarray) -> np.ndarray:
         """(rows, 2K) values per contact end, summed per ball: (rows, M), with one ``np.bincount`` over

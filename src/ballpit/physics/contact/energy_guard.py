@@ -93,7 +93,7 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, p
     """
     if not model.guards.lift:
         return
-    moved = np.flatnonzero((new != old).any(axis=1))
+    moved = ((new != old).any(axis=1)).nonzero()[0]
     if moved.size == 0:
         return
     mass = model.spheres.mass[moved]

@@ -85,9 +85,9 @@ def in_waves(
     while waves < MAX_WAVES:
         vn = rows.normal_speeds(v)
         arriving = (vn < min_normal_speed - APPROACH_SPEED) & (-vn > restitution_threshold)
-        if not arriving.any():
+        if not np.count_nonzero(arriving):
             break
-        idx = np.flatnonzero(arriving)
+        idx = arriving.nonzero()[0]
         wave = rows.subset(idx)
         before = _velocities(wave, v, w)
         imp = solver.solve(
@@ -139,7 +139,7 @@ def stop_approaches(
     v, w = with_static(state.body[:, V]), with_static(state.body[:, W])
     vn = rows.normal_speeds(v)
     seeds = vn < min_normal_speed - APPROACH_SPEED
-    if not seeds.any():
+    if not np.count_nonzero(seeds):
         return
     near = _island(model, c, seeds)
     island = rows.subset(near)
@@ -217,7 +217,7 @@ def waves_from(
     after = np.array(vn_start)
     struck = np.zeros(k.k, bool)
     # the contacts that can take part, with what the waves need of them
-    cand = np.flatnonzero(pressed & (k.ima + k.imb > 0.0))
+    cand = (pressed & (k.ima + k.imb > 0.0)).nonzero()[0]
     kk, m = k.k, k.m
     ea, eb = k.ends[:kk][cand], k.ends[kk:][cand]
     n = k.n[:, cand]
@@ -226,14 +226,14 @@ def waves_from(
 
     def speeds(v: np.ndarray, at: np.ndarray | slice = slice(None)) -> np.ndarray:
         s = None if surface is None else surface[:, at]
-        return contact_model.normal_speed(np.take(v, ea[at], axis=1), np.take(v, eb[at], axis=1), n[:, at], s)
+        return contact_model.normal_speed(v.take(ea[at], axis=1), v.take(eb[at], axis=1), n[:, at], s)
 
     offset = vn_start[cand] - speeds(copy)
     vn = vn_start[cand]
     inv3 = np.tile(k.inverse[0], 3)  # each column's own 1/m, for x, y and z
     closing = -max(restitution_threshold, APPROACH_SPEED)
     for _ in range(MAX_WAVES):
-        idx = np.flatnonzero(vn < closing)  # the contacts arriving now
+        idx = (vn < closing).nonzero()[0]  # the contacts arriving now
         if idx.size == 0:
             break
         struck[cand[idx]] = True
@@ -250,7 +250,7 @@ def waves_from(
         moved = np.zeros(m, bool)
         moved[wave[0]] = True
         moved[wave[1]] = True
-        near = np.flatnonzero(moved[ea] | moved[eb])
+        near = (moved[ea] | moved[eb]).nonzero()[0]
         vn[near] = speeds(copy, near) + offset[near]
     after[cand] = vn
     return after, struck
@@ -282,7 +282,7 @@ def _wave_sweeps(
     rows3 = np.concatenate((ends, ends + m, ends + 2 * m))
     impulse = np.zeros(len(ea)) if start is None else start
     for _ in range(sweeps):
-        vn = contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
+        vn = contact_model.normal_speed(v.take(ea, axis=1), v.take(eb, axis=1), n, surface)
         new = contact_model.normal_impulse(impulse, m_n, target, vn)
         d = new - impulse
         impulse = new
@@ -295,7 +295,7 @@ def _wave_sweeps(
         ).reshape(3, m)
         if change < CONVERGED:
             break
-    return impulse, contact_model.normal_speed(np.take(v, ea, axis=1), np.take(v, eb, axis=1), n, surface)
+    return impulse, contact_model.normal_speed(v.take(ea, axis=1), v.take(eb, axis=1), n, surface)
 
 
 def normal_solve(

@@ -32,7 +32,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
     whether any ball moved."""
     radius = model.spheres.radius
     tolerance = min(PENETRATION_TOLERANCE, OVERLAP_PER_RADIUS * float(radius.min())) if len(radius) else 0.0
-    if not np.any(c.gap < -tolerance):
+    if not np.count_nonzero(c.gap < -tolerance):
         return False
     x = state.body[:, X]
     pos = with_static(x)
@@ -43,7 +43,7 @@ def remove_penetration(model: Model, state: State, c: ContactPoints, rows: Conta
         _separate_by_colour(c, rows, pos)
     new = keep_sides_of_planes(model, state, x, pos[:-1], deeper=True)
     energy_guard.pay_for_lift(model, state, x, new, partly=True)
-    moved = bool((new != x).any())
+    moved = bool(np.count_nonzero(new != x))
     x[:] = new
     return moved
 
@@ -73,9 +73,9 @@ def separate(
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
 
     def along() -> np.ndarray:  # n·(x_a − x_b) per contact
-        d = n[0] * (np.take(x[0], ea) - np.take(x[0], eb))
-        d += n[1] * (np.take(x[1], ea) - np.take(x[1], eb))
-        d += n[2] * (np.take(x[2], ea) - np.take(x[2], eb))
+        d = n[0] * (x[0].take(ea) - x[0].take(eb))
+        d += n[1] * (x[1].take(ea) - x[1].take(eb))
+        d += n[2] * (x[2].take(ea) - x[2].take(eb))
         return d
 
     start = along()
@@ -120,7 +120,7 @@ def keep_sides_of_planes(
     limits (the plane was not within its reach), and planes are two-sided: through one, it would be
     pushed on out the wrong side.
     """
-    moved = np.flatnonzero((new != old).any(axis=1))
+    moved = ((new != old).any(axis=1)).nonzero()[0]
     if moved.size == 0 or model.planes.count == 0:
         return new
     pose, half, radius = state.planes, model.planes.half_size, model.spheres.radius[moved]
@@ -135,9 +135,9 @@ def keep_sides_of_planes(
         # ones (it was out of reach before the move), and the ball would fly on into it
         floor = np.minimum(radius, np.abs(d0)) - HOLD_SINK * radius
         into = ~crossing & (np.where(d0 >= 0.0, d1, -d1) < floor) & deeper
-        if not (crossing.any() or into.any()):
+        if not (np.count_nonzero(crossing) or np.count_nonzero(into)):
             continue
-        k = np.flatnonzero(crossing | into)
+        k = (crossing | into).nonzero()[0]
         # where the centre crosses, or ends
         through = np.where(
             crossing[k, None], start[k] + (d0[k] / (d0[k] - d1[k]))[:, None] * path[k], new[moved[k]]

@@ -81,7 +81,7 @@ class WarmStart:
         asleep): sleeping pairs are not solved, so the next ``keep`` would forget them, and a pile woken
         with no warm start sags under its own weight and springs back up, gaining energy."""
         held = _asleep_pairs(self.keys, asleep)
-        if not held.any():
+        if not np.count_nonzero(held):
             return
         self.asleep = _merged(self.asleep, _rows((self.keys, self.forces, self.apart), held))
 
@@ -96,7 +96,7 @@ class WarmStart:
             return
         woken = ~still
         fresh = ~np.isin(keys[woken], self.keys)  # a pair solved since keeps what it was solved to
-        back = np.flatnonzero(woken)[fresh]
+        back = woken.nonzero()[0][fresh]
         merged = _merged((self.keys, self.forces, self.apart), _rows(self.asleep, back))
         self.keys, self.forces, self.apart = merged
         self.asleep = _rows(self.asleep, still)
@@ -189,7 +189,7 @@ def resting_forces(
     v_free, w_free = v.copy(), w.copy()
     keys = c.keys()
     imp = warm.impulses(keys, c.normal, h)
-    if rows.moving and model.plane_spin().any():  # the contacts at the interval's end
+    if rows.moving and np.count_nonzero(model.plane_spin()):  # the contacts at the interval's end
         rows = rows_at_end(model, state, c, rows, lin, h, imp)
     solver.warm_start(rows, v, w, imp)
     solver.solve(rows, v, w, min_normal_speed, imp, model.solver_iterations, jacobi_from=jacobi_from)
@@ -271,7 +271,7 @@ def hold_by_planes(
        and its planes back).
     """
     static = (rows.inv_mass_b == 0.0) & (rows.inv_mass_a > 0.0)
-    if not static.any():
+    if not np.count_nonzero(static):
         return
     vn0, vn1 = rows.normal_speeds(v_start), rows.normal_speeds(v)
     r = radius[rows.a]
@@ -280,17 +280,17 @@ def hold_by_planes(
     else:
         sink = h * ((1.0 - 0.5 * bend) * vn0 + (0.5 * bend) * vn1)
     deeper = static & (gap + sink < np.minimum(gap, 0.0) - HOLD_SINK * r)
-    if not deeper.any():
+    if not np.count_nonzero(deeper):
         return
     balls = len(v)
     held = np.zeros(balls, bool)
     held[rows.a[deeper]] = True
-    planes = np.flatnonzero(static & held[rows.a])
+    planes = (static & held[rows.a]).nonzero()[0]
     _push_off_planes(rows, v, target, normal, planes)
     # the directions each held ball is held in, made orthonormal (at most three): first the normals of
     # the planes pushing it
     slot = np.full(balls, -1)
-    slot[np.flatnonzero(held)] = np.arange(np.count_nonzero(held))
+    slot[held.nonzero()[0]] = np.arange(np.count_nonzero(held))
     basis = np.zeros((np.count_nonzero(held), 3, 3))
     count = np.zeros(len(basis), np.intp)
     pushing = planes[normal[planes] > 0.0]
@@ -299,7 +299,7 @@ def hold_by_planes(
     moved = held.copy()
     newest, done, layers = held.copy(), static.copy(), []
     for _ in range(HOLD_LAYERS):
-        pressed = np.flatnonzero(~done & (newest[rows.a] | newest[rows.b]))
+        pressed = (~done & (newest[rows.a] | newest[rows.b])).nonzero()[0]
         if pressed.size == 0:
             break
         done[pressed] = True
@@ -312,22 +312,22 @@ def hold_by_planes(
         fresh = np.zeros(balls, bool)
         fresh[a[new_a]] = True
         fresh[b[new_b]] = True
-        if not fresh.any():
+        if not np.count_nonzero(fresh):
             break
-        grown = np.flatnonzero(fresh)
+        grown = fresh.nonzero()[0]
         slot[grown] = len(basis) + np.arange(len(grown))
         basis = np.concatenate((basis, np.zeros((len(grown), 3, 3))))
         count = np.concatenate((count, np.zeros(len(grown), np.intp)))
         ends = np.concatenate((a[new_a], b[new_b]))
         normals = np.concatenate((nk[new_a], nk[new_b]))
-        joining = pressed[np.concatenate((np.flatnonzero(new_a), np.flatnonzero(new_b)))]
+        joining = pressed[np.concatenate((new_a.nonzero()[0], new_b.nonzero()[0]))]
         for group in rows.subset(joining).colours:  # one contact per ball in each colour
             _hold_along(basis, count, slot[ends[group]], normals[group])
         held |= fresh
         newest = fresh
     for pressed in reversed(layers[:-1] if len(layers) > 1 else []):  # from the top down
         _press(rows, pressed, held, basis, slot, v, target, normal, moved)
-    last = np.flatnonzero(static & moved[rows.a])
+    last = (static & moved[rows.a]).nonzero()[0]
     for _ in range(HOLD_PASSES):  # one is exact against square walls; a few for planes at an angle
         _push_off_planes(rows, v, target, normal, last)
 

@@ -9,18 +9,21 @@ zero inverse mass (docs/architecture.md, "Conventions").
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
 from ..core import exact
 from ..core.contacts import SPHERE_PLANE, ContactPoints, take_indices
-from ..core.state import State
+from ..core.settings import ONE_COLOUR_CHECK_UP_TO
+from ..core.state import State, shallow_copy
 from ..dynamics import moving_planes
 from ..dynamics.model import Model
 from . import contact_model
 from .contact_model import Impulses
+
+_ZERO = np.zeros(1)
 
 
 @dataclass
@@ -50,9 +53,18 @@ class ContactRows:
 
     def arm_lengths(self, idx: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """|r_a| and |r_b| of the contacts ``idx``: the radii, or zero on a plane's side, as the lengths
-        of the lever arms −radius_a·n and radius_b·n (formed here and dropped: (K, 3) each)."""
-        n = self.normal[idx]
-        return exact.norm_rows(-self.radius_a[idx, None] * n), exact.norm_rows(self.radius_b[idx, None] * n)
+        of the lever arms −radius_a·n and radius_b·n (read only)."""
+        a, b = self._arms
+        return a[idx], b[idx]
+
+    @cached_property
+    def _arms(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every contact's |r_a| and |r_b|, formed once (the solves ask for them several times an
+        interval; each row's length is the same whichever rows are asked for)."""
+        n = self.normal
+        a, b = exact.norm_rows(-self.radius_a[:, None] * n), exact.norm_rows(self.radius_b[:, None] * n)
+        a.flags.writeable = b.flags.writeable = False
+        return a, b
 
     @cached_property
     def colours(self) -> list[np.ndarray]:
@@ -64,21 +76,22 @@ class ContactRows:
         velocities ``v`` (row N the static world), against a moving plane's surface: the contact model's
         ``normal_speed`` on these rows."""
         surface = self.surface[idx].T if self.moving else None
-        v_a, v_b = np.take(v, self.a[idx], axis=0).T, np.take(v, self.b[idx], axis=0).T  # faster than v[a]
+        v_a, v_b = v.take(self.a[idx], axis=0).T, v.take(self.b[idx], axis=0).T  # faster than v[a]
         return contact_model.normal_speed(v_a, v_b, self.normal[idx].T, surface)
 
     def subset(self, mask: np.ndarray) -> ContactRows:
         """The contacts where ``mask`` holds."""
         kept = ("moving", "static")
         idx = take_indices(mask)
-        fields = {k: np.take(v, idx, axis=0) for k, v in vars(self).items() if k not in (*kept, "colours")}
+        found = (*kept, "colours", "_arms")  # worked out from the rows, not rows themselves
+        fields = {k: v.take(idx, axis=0) for k, v in vars(self).items() if k not in found}
         return ContactRows(**fields, moving=self.moving, static=self.static)
 
 
 def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
     """Masses, lever arms, mixed materials and surface motion of the contacts ``c``, in colours."""
     sph, pl = model.spheres, model.planes
-    with_static = lambda arr: np.append(arr, 0.0)  # noqa: E731 - row N is the static world
+    with_static = lambda arr: np.concatenate((arr, _ZERO))  # noqa: E731 - row N is the static world
     radius, inv_mass, inv_inertia = (with_static(a) for a in (sph.radius, sph.inv_mass, sph.inv_inertia))
     if state.sleep.any:  # a sleeping ball an awake one leans on holds like a plane (sleeping.py)
         held = np.append(state.sleep.asleep, False)
@@ -130,6 +143,11 @@ def colour(a: np.ndarray, b: np.ndarray, static: int) -> list[np.ndarray]:
     (Luby's independent sets); priorities are a fixed hash of the index, so colouring is deterministic.
     """
     remaining = np.arange(len(a))
+    if 0 < len(a) <= ONE_COLOUR_CHECK_UP_TO:  # a few contacts on different balls: one colour
+        ends = np.concatenate((a, b[b != static]))
+        ends.sort()
+        if not np.count_nonzero(ends[1:] == ends[:-1]):
+            return [remaining]
     priority = (remaining.astype(np.uint64) * np.uint64(2654435761)) % np.uint64(4294967291)
     order = np.argsort(priority, kind="stable")
     rank = np.empty(len(a), np.int64)
@@ -172,13 +190,13 @@ def rows_at_end(
     on_plane = c.kind == SPHERE_PLANE
     spins = model.plane_spin()  # a plane too slow for its rate to be formed does not turn
     turning = spins.any(axis=1)
-    on = np.flatnonzero(on_plane & turning[np.where(on_plane, c.other, 0)])
+    on = (on_plane & turning[np.where(on_plane, c.other, 0)]).nonzero()[0]
     if on.size == 0:
         return rows
     plane, ball = c.other[on], c.a[on]
     spin = spins[plane]
     rates = [exact.norm_floats(x, y, z) for x, y, z in spins.tolist()]
-    sin_all, cos_all = exact.sin_cos(np.array(rates) * h)  # not math's: its bits depend on the CPU
+    sin_all, cos_all = _sin_cos(np.array(rates) * h)
     sin, cos = sin_all[plane, None], cos_all[plane, None]
     axis = spin / np.array(rates)[plane, None]
     n = rows.normal[on]
@@ -195,7 +213,26 @@ def rows_at_end(
     surface[on] = pl.velocity[plane] + exact.cross_rows(spin, centre - radius * turned - plane_centre)
     friction = warm.friction[on]
     warm.friction[on] = friction - exact.dot_rows(friction, turned)[:, None] * turned
-    end = replace(rows, normal=normal, surface=surface)  # the lever arms turn with the normal
-    if "colours" in rows.__dict__:  # the same contacts: the same colours
-        end.__dict__["colours"] = rows.colours
+    end = shallow_copy(rows)  # the same contacts (and colours, if found), their normals and surfaces
+    end.normal, end.surface = normal, surface  # turned; the lever arms turn with the normal
+    end.__dict__.pop("_arms", None)
     return end
+
+
+# The planes' sines and cosines by their angles' bits: planes turning steadily turn by the same angles
+# every whole step, so they are worked out once (as moving_planes keeps its turns).
+_SIN_COS: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+_SIN_COS_KEPT = 256
+
+
+def _sin_cos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``exact.sin_cos`` of a few planes' angles (not math's: its bits depend on the CPU), remembered."""
+    key = angle.tobytes()
+    found = _SIN_COS.get(key)
+    if found is None:
+        if len(_SIN_COS) >= _SIN_COS_KEPT:
+            _SIN_COS.clear()
+        sin, cos = exact.sin_cos(angle)
+        sin.flags.writeable = cos.flags.writeable = False
+        found = _SIN_COS[key] = (sin, cos)
+    return found

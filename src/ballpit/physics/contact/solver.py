@@ -22,6 +22,9 @@ from .contact_model import Impulses
 from .ends import Ends
 from .rows import ContactRows
 
+_SIX = np.arange(6)
+# (Maxima here are np.maximum.reduce: ndarray.max's Python wrapper costs more than a few contacts' max.)
+
 
 class _Colour:
     """One colour's contacts, gathered once per solve so the sweeps only touch velocities.
@@ -43,17 +46,20 @@ class _Colour:
         # what a unit of tangential impulse turns each ball by (Δω = −ρ·I⁻¹·(n × P_t))
         self.turn_a, self.turn_b = -(self.ra * self.iia), -(self.rb * self.iib)
         # bounds on how much a unit of impulse changes a contact's velocity, for the convergence test
-        self.max_inv_m_n, self.max_inv_m_t = float(inverse[0].max()), float(inverse[1].max())
+        self.max_inv_m_n, self.max_inv_m_t = (
+            float(np.maximum.reduce(inverse[0])),
+            float(np.maximum.reduce(inverse[1])),
+        )
         self.mu = contacts.friction[idx]
         self.rolling = contacts.rolling[idx]
         self.surface = np.ascontiguousarray(contacts.surface[idx].T) if contacts.moving else None
         self.spin = np.ascontiguousarray(contacts.spin[idx].T) if contacts.moving else None
-        self.has_friction = bool(self.mu.any())
-        self.has_rolling = bool(self.rolling.any())
+        self.has_friction = bool(np.count_nonzero(self.mu))
+        self.has_rolling = bool(np.count_nonzero(self.rolling))
         # how a unit of friction's turn changes the relative spin (c = ρ_a/I_a − ρ_b/I_b), and a bound
         # on the surface speed a unit of rolling impulse changes (|ΔΩ|·ρ), for the convergence test
         self.lever = self.ra * self.iia - self.rb * self.iib
-        self.max_roll = float((self.iia * self.ra + self.iib * self.rb).max())
+        self.max_roll = float(np.maximum.reduce(self.iia * self.ra + self.iib * self.rb))
 
 
 def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -65,16 +71,20 @@ def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulse
     linear = imp.normal * n + friction
     turn = model.turn(n, friction)
     ra, rb = contacts.arm_lengths()
-    rows = len(v)
+    rows, k = len(v), len(contacts)
+    change = np.empty((k, 6))  # each contact's [Δv Δω] on one of its bodies, a row each
     for body, sign, im, ii, r in (
         (contacts.a, 1.0, contacts.inv_mass_a, contacts.inv_inertia_a, ra),
         (contacts.b, -1.0, contacts.inv_mass_b, contacts.inv_inertia_b, rb),
     ):
-        dv = sign * linear * im
-        dw = (-r * turn + sign * rolling) * ii
-        for axis in range(3):
-            v[:, axis] += np.bincount(body, dv[axis], minlength=rows)
-            w[:, axis] += np.bincount(body, dw[axis], minlength=rows)
+        change[:, :3] = (sign * linear * im).T
+        change[:, 3:] = ((-r * turn + sign * rolling) * ii).T
+        # one bincount for all six columns (bin 6·ball + column): each bin sums its contacts in their
+        # order from zero, as a bincount per column does
+        bins = (body[:, None] * 6 + _SIX).ravel()
+        sums = np.bincount(bins, change.ravel(), minlength=6 * rows).reshape(rows, 6)
+        v += sums[:, :3]
+        w += sums[:, 3:]
     v[-1] = 0.0
     w[-1] = 0.0
 
@@ -101,7 +111,7 @@ def solve(
     # Work on a compact copy of just the balls these contacts touch: an island's solve costs what
     # the island does, not what the world does.
     ends = Ends(contacts.a, contacts.b)
-    vw = np.ascontiguousarray(np.hstack((v[ends.balls], w[ends.balls])).T)  # (6, M)
+    vw = np.ascontiguousarray(np.concatenate((v[ends.balls], w[ends.balls]), axis=1).T)  # (6, M)
     colours = [_Colour(contacts, idx, ends.ends) for idx in contacts.colours]
     targets = [target[c.idx] for c in colours]
     normal = [imp.normal[c.idx] for c in colours]
@@ -130,7 +140,7 @@ def _sweep_colour(
     """One colour's update, in Gauss–Seidel order within each contact: normal impulse, then friction,
     then rolling resistance (from the spin friction left). Returns a bound on the largest velocity
     change it made (m/s)."""
-    ga, gb = np.take(vw, c.a, axis=1), np.take(vw, c.b, axis=1)
+    ga, gb = vw.take(c.a, axis=1), vw.take(c.b, axis=1)
     va, wa, vb, wb = ga[:3], ga[3:], gb[:3], gb[3:]
     rel = model.contact_velocity(va, wa, vb, wb, c.n, c.ra, c.rb, c.surface)
     vn = exact.dot_cols(rel, c.n)
@@ -140,7 +150,7 @@ def _sweep_colour(
     normal[k] = new
     d_n = new - old
     linear = d_n * c.n
-    change = float(np.abs(d_n).max()) * c.max_inv_m_n
+    change = float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
 
     if c.has_friction and c.has_rolling:
         # friction and rolling resistance together: where both stay within their limits the block
@@ -165,7 +175,11 @@ def _sweep_colour(
         turn = model.turn(c.n, d_t)
         wa += c.turn_a * turn + c.iia * d_r
         wb += c.turn_b * turn - c.iib * d_r
-        change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t, float(np.abs(d_r).max()) * c.max_roll)
+        change = max(
+            change,
+            float(np.maximum.reduce(np.abs(d_t), axis=None)) * c.max_inv_m_t,
+            float(np.maximum.reduce(np.abs(d_r), axis=None)) * c.max_roll,
+        )
     elif c.has_friction:
         # friction cancels slip (the tangential part of rel, which the normal impulse leaves alone)
         old_t = friction[k]
@@ -176,7 +190,7 @@ def _sweep_colour(
         turn = model.turn(c.n, d_t)
         wa += c.turn_a * turn
         wb += c.turn_b * turn
-        change = max(change, float(np.abs(d_t).max()) * c.max_inv_m_t)
+        change = max(change, float(np.maximum.reduce(np.abs(d_t), axis=None)) * c.max_inv_m_t)
     elif c.has_rolling:
         # rolling resistance opposes relative spin, up to ρ_roll·P_n
         old_r = rolling[k]
@@ -186,7 +200,7 @@ def _sweep_colour(
         d_r = new_r - old_r
         wa += c.iia * d_r
         wb -= c.iib * d_r
-        change = max(change, float(np.abs(d_r).max()) * c.max_roll)
+        change = max(change, float(np.maximum.reduce(np.abs(d_r), axis=None)) * c.max_roll)
 
     va += c.ima * linear
     vb -= c.imb * linear

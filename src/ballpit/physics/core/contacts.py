@@ -96,8 +96,8 @@ class ContactPoints:
     def subset(self, mask: np.ndarray) -> ContactPoints:
         """The contacts where ``mask`` holds (or at the indices ``mask``), in their order."""
         idx = take_indices(mask)
-        parts = {f.name: getattr(self, f.name) for f in fields(ContactPoints)}
-        return ContactPoints(**{k: None if v is None else np.take(v, idx, axis=0) for k, v in parts.items()})
+        parts = [getattr(self, name) for name in _POINT_FIELDS]
+        return ContactPoints(*[None if v is None else v.take(idx, axis=0) for v in parts])
 
     def gaps(self) -> ContactPoints:
         """The same pairs with only their kind, bodies (a, other) and gaps: what a soft frame keeps of
@@ -106,9 +106,7 @@ class ContactPoints:
 
     @staticmethod
     def concatenate(parts: list[ContactPoints]) -> ContactPoints:
-        return ContactPoints(
-            **{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(ContactPoints)}
-        )
+        return ContactPoints(*[np.concatenate([getattr(p, name) for p in parts]) for name in _POINT_FIELDS])
 
     def keys(self) -> np.ndarray:
         """A unique integer per pair, built from the pair's own identity (the ball's index and the
@@ -116,11 +114,15 @@ class ContactPoints:
         return pair_keys(self.a, self.other, self.kind == SPHERE_PLANE)
 
 
+# ContactPoints' fields in their order (``dataclasses.fields`` costs more than a subset of a few contacts)
+_POINT_FIELDS = tuple(f.name for f in fields(ContactPoints))
+
+
 def take_indices(mask: np.ndarray) -> np.ndarray:
     """The indices a boolean ``mask`` selects (indices are returned as they are): taking rows by
     index from several arrays costs a third of what indexing each with the same boolean mask does,
     which finds the indices again for every array."""
-    return np.flatnonzero(mask) if mask.dtype == bool else mask
+    return mask.nonzero()[0] if mask.dtype == bool else mask  # (1-D: np.flatnonzero without its ravel)
 
 
 # A pair's key: ball a in the high 32 bits; in the low 32, the other ball, or a plane with bit 31 set.
@@ -146,7 +148,7 @@ class EventLog:
 
     def add(self, time: float, contacts: ContactPoints, keys: np.ndarray, impulse: np.ndarray) -> None:
         hit = impulse > 0.0
-        if hit.any():
+        if np.count_nonzero(hit):
             self._parts.append((np.full(int(hit.sum()), time), contacts.subset(hit), keys[hit], impulse[hit]))
 
     def add_resting(
@@ -173,6 +175,9 @@ class EventLog:
     def record(self) -> ContactRecord:
         if not self._parts:
             return ContactRecord.empty()
+        if len(self._parts) == 1:  # one add: one entry per pair already, in order, at one time
+            time, c, _, impulse = self._parts[0]
+            return ContactRecord(time, c.kind.astype(np.int8), c.a, c.other, c.point, c.normal, impulse)
         time = np.concatenate([p[0] for p in self._parts])
         keys = np.concatenate([p[2] for p in self._parts])
         impulse = np.concatenate([p[3] for p in self._parts])

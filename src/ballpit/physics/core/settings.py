@@ -76,6 +76,9 @@ BROAD_PHASE_MARGIN = 0.1
 DENSE_CELLS_PER_BALL = 16
 # Up to this many boxes, testing every pair at once costs fewer array operations than the grid.
 ALL_PAIRS_UP_TO = 48
+# Sphere–plane pairs are tested for this many (ball, plane) pairs at a time, planes taken together: a
+# handful of balls and planes in one pass, a crowd one plane at a time.
+PLANE_PAIRS_AT_ONCE = 4096
 # The grid's cell is this many times the median box's largest side (or the largest box, if smaller):
 # the smallest cell that still holds most boxes whole keeps the fewest boxes per cell to test (in a
 # packed pile a cell of twice the median box holds ~8× fewer than one as large as the largest box).
@@ -206,6 +209,10 @@ BOUNCE_JACOBI_SWEEPS = 1
 APPROACH_SPEED = 1e-6
 
 # --- Contact solves (solver.py, jacobi.py, resting.py; the contact model is contact_model.py) ---------
+
+# Up to this many contacts, the colouring first checks whether any ball has two of them (one colour
+# then, as the first round of Luby's method would find, at a fraction of its cost).
+ONE_COLOUR_CHECK_UP_TO = 64
 
 # Default of ``World.solver_iterations``: projected Gauss–Seidel sweeps per solve.
 SOLVER_ITERATIONS = 10

@@ -129,7 +129,7 @@ class Sleep:
 
     @property
     def any(self) -> bool:
-        return bool(self.asleep.any())
+        return bool(np.count_nonzero(self.asleep))
 
     def wake(self, balls: np.ndarray) -> None:
         """Wake the islands of the sleeping balls ``balls`` (a mask or indices), whole."""

@@ -143,7 +143,7 @@ def _unsteppable(body: np.ndarray) -> str | None:
     velocity (nan)"), or None."""
     # Every value within the smallest limit passes: two passes over the block, no temporaries (a NaN
     # makes max and min NaN, which fails too). Only then is it looked at field by field.
-    if len(body) == 0 or (body.max() <= _SMALLEST_LIMIT and body.min() >= -_SMALLEST_LIMIT):
+    if len(body) == 0 or _within_smallest_limit(body):
         return None
     bad = ~(np.abs(body) <= _STATE_LIMITS)  # NaN compares false
     if not bad.any():
@@ -154,10 +154,21 @@ def _unsteppable(body: np.ndarray) -> str | None:
     return f"{row} has {what} {field} ({body[row, col]})"
 
 
+def _within_smallest_limit(body: np.ndarray) -> bool:
+    """Every value of ``body`` within the smallest limit (a NaN makes the max and min NaN, which fail):
+    two reductions without ``ndarray.max``'s Python wrapper."""
+    return bool(
+        np.maximum.reduce(body, axis=None) <= _SMALLEST_LIMIT
+        and np.minimum.reduce(body, axis=None) >= -_SMALLEST_LIMIT
+    )
+
+
 def step_fault(body: np.ndarray) -> FloatingPointError | ValueError | None:
     """What is wrong with the state ``body`` a step left, as the error to raise once the step is undone,
     or None: a NaN/inf, or a value the next step would refuse (``step(1e6)`` let balls fall 5e12 m, and
     the next step then refused the world's own state)."""
+    if len(body) == 0 or _within_smallest_limit(body):  # the common case: finite and within every limit
+        return None
     if not np.isfinite(body).all():
         bad = int(np.flatnonzero(~np.isfinite(body).all(axis=1))[0])
         return FloatingPointError(f"step made sphere #{bad}'s state non-finite; the step was undone")
@@ -210,8 +221,8 @@ def _bad_plane_values(kind: str, arr: np.ndarray, limit: float | None) -> np.nda
 def plane_columns(shape, pose) -> list[np.ndarray]:
     """The live plane columns ``reject_bad_planes`` checks (``shape``/``pose``: the model's and the
     state's plane Columns), in its order."""
-    n = shape.count  # every step looks: full(name)[:n] costs a third of Columns.__getattr__
-    return [(pose if where == "pose" else shape).full(name)[:n] for name, where, _, _ in _PLANE_FIELDS]
+    # every step looks: each column's live rows are a plain attribute (``Columns._publish``)
+    return [getattr(pose if where == "pose" else shape, name) for name, where, _, _ in _PLANE_FIELDS]
 
 
 class PlanesAsStepped:

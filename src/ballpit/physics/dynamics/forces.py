@@ -87,7 +87,7 @@ def free_acceleration(body: np.ndarray, forces: list[ForceTerm]) -> tuple[np.nda
     """Linear and angular acceleration of each ball from the force terms alone, at state ``body``."""
     constant = constant_acceleration(forces)
     if constant is not None:  # the same sums, made once (or once per ball) and repeated
-        return tuple(np.repeat(a, len(body), axis=0) if len(a) == 1 else a for a in constant)
+        return tuple(a.repeat(len(body), axis=0) if len(a) == 1 else a for a in constant)
     lin = np.zeros((len(body), 3))
     ang = np.zeros((len(body), 3))
     for term in forces:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import quaternion
+from ..core import exact, quaternion
 from ..core.state import Q, V, W, X
 from ..core.workspace import Workspace
 from .forces import ForceTerm, constant_acceleration
@@ -161,7 +161,7 @@ class Integrator:
     def closing_speed_bound(self, dv: np.ndarray, da: np.ndarray, h: float) -> np.ndarray:
         """A bound on how fast each pair can close over the next ``h``, from the relative velocity and
         acceleration along this path: |Δv| + |Δb|·h (the second term is zero on a straight path)."""
-        return np.linalg.norm(dv, axis=1) + np.linalg.norm(self.path_acceleration(da), axis=1) * h
+        return exact.norm_rows(dv) + exact.norm_rows(self.path_acceleration(da)) * h
 
 
 # The registry, in the order of the viewer's number keys. Colours read on the plots' white and the

@@ -115,29 +115,53 @@ class Model:
 
     def moving_planes(self) -> bool:
         """True when some plane has a velocity or turns (``plane_spin``)."""
-        return bool(self.planes.velocity.any() or self.plane_spin().any())
+        return self._plane_motion()[2]
 
     def moving_plane_mask(self) -> np.ndarray:
-        """Which planes have a velocity or turn (``plane_spin``), one flag per plane."""
-        return self.planes.velocity.any(axis=1) | self.plane_spin().any(axis=1)
+        """Which planes have a velocity or turn (``plane_spin``), one flag per plane (read only)."""
+        return self._plane_motion()[3]
 
     def plane_spin(self) -> np.ndarray:
         """Each plane's angular velocity as the step turns it (P, 3; read only): as written, but zero
         for a plane turning slower than SLOWEST_TURN, whose rate cannot be formed from its squares.
         Every stage of the step reads a plane's spin from here, so such a plane is still in all of them
         alike (one turning in one stage and still in another could be missed by the time of impact)."""
-        spin = self.planes.angular_velocity
-        if not spin.any():
-            return spin
-        x, y, z = spin[:, 0], spin[:, 1], spin[:, 2]  # (exact.dot_rows' sums, without its call: read often)
-        still = (x * x + y * y) + z * z < SLOWEST_TURN * SLOWEST_TURN
-        return np.where(still[:, None], 0.0, spin) if still.any() else spin
+        spin, _, _, _, turned = self._plane_motion()
+        return spin if turned is None else turned
+
+    def _plane_motion(self) -> tuple:
+        """(angular velocity as written, its bytes with the velocities', moving?, which move, the spin
+        with the too-slow planes zeroed or None when none is): read a dozen times a step, so worked
+        out again only when a plane's velocity or angular velocity changed (they are compared by
+        their bytes, which is cheaper than working them out)."""
+        velocity, spin = self.planes.velocity, self.planes.angular_velocity
+        key = velocity.tobytes() + spin.tobytes()
+        memo = self.__dict__.get("_motion")
+        if memo is not None and memo[1] == key:
+            return (spin, *memo[1:])
+        turned = None
+        if np.count_nonzero(spin):
+            x, y, z = spin[:, 0], spin[:, 1], spin[:, 2]  # exact.dot_rows' sums, without its call
+            still = (x * x + y * y) + z * z < SLOWEST_TURN * SLOWEST_TURN
+            if np.count_nonzero(still):
+                turned = np.where(still[:, None], 0.0, spin)
+                turned.flags.writeable = False
+        turning = spin if turned is None else turned
+        moving = bool(np.count_nonzero(velocity) or np.count_nonzero(turning))
+        mask = velocity.any(axis=1) | turning.any(axis=1) if moving else np.zeros(len(spin), bool)
+        mask.flags.writeable = False
+        self._motion = (spin, key, moving, mask, turned)
+        return self._motion
 
     def contact_slop(self) -> float:
         """The gap (m) under which a pair is touching in this world, for every stage of the step:
         CONTACT_SLOP, or SLOP_PER_RADIUS of the smallest ball's radius if that is less."""
-        radius = self.spheres.radius
-        return min(CONTACT_SLOP, SLOP_PER_RADIUS * float(radius.min())) if len(radius) else CONTACT_SLOP
+        radius = self.spheres.radius  # (the smallest by the ufunc's reduce, without ndarray.min's wrapper)
+        return (
+            min(CONTACT_SLOP, SLOP_PER_RADIUS * float(np.minimum.reduce(radius)))
+            if len(radius)
+            else CONTACT_SLOP
+        )
 
     def forces(self) -> list[ForceTerm]:
         """The force terms acting on every ball: gravity, then the drags that are switched on."""
@@ -157,4 +181,5 @@ class Model:
         """
         if self.restitution_threshold is not None:
             return self.restitution_threshold
-        return self.integrator.threshold_steps * float(exact.norm_rows(self.gravity)) * dt
+        # |g| in Python floats: the same squares summed in the same order, correctly rounded alike
+        return self.integrator.threshold_steps * exact.norm_floats(*self.gravity.tolist()) * dt

@@ -41,7 +41,7 @@ def advance(model: Model, state: State, h: float) -> None:
     """
     pl, pose = model.planes, state.planes
     velocity, spin = pl.velocity, model.plane_spin()
-    moving = np.flatnonzero(model.moving_plane_mask())
+    moving = (model.moving_plane_mask()).nonzero()[0]
     if moving.size == 0:
         return
     center, orientation = pose.center, pose.orientation
@@ -115,7 +115,7 @@ def frames_at(model: Model, state: State, plane: np.ndarray, t: np.ndarray) -> t
     pl, pose = model.planes, state.planes
     center = pose.center[plane] + pl.velocity[plane] * t[:, None]
     spin = model.plane_spin()[plane]
-    rate = np.linalg.norm(spin, axis=1)
+    rate = exact.norm_rows(spin)
     axis = spin / np.where(rate > 0.0, rate, 1.0)[:, None]
     turn = quaternion.from_axis_angle(axis, rate * t)  # the identity where the plane does not turn
     return center, quaternion.rotate(turn, pose.axis_u[plane]), quaternion.rotate(turn, pose.axis_v[plane])
@@ -137,6 +137,6 @@ def closing_speed_bound(
     distance from the plane's centre over the interval (the closest point is never farther)."""
     pl = model.planes
     dv = v - pl.velocity[plane]
-    linear = np.linalg.norm(dv, axis=1) + np.linalg.norm(acc, axis=1) * h
-    far = np.linalg.norm(state.body[ball, 0:3] - state.planes.center[plane], axis=1) + linear * h
-    return linear + np.linalg.norm(model.plane_spin()[plane], axis=1) * far
+    linear = exact.norm_rows(dv) + exact.norm_rows(acc) * h
+    far = exact.norm_rows(state.body[ball, 0:3] - state.planes.center[plane]) + linear * h
+    return linear + exact.norm_rows(model.plane_spin()[plane]) * far

@@ -15,6 +15,7 @@ from ..core.workspace import Workspace
 # copies ``_dq`` needs for ω × q are plain row slices.
 _X, _V, _Q6, _Q, _W5, _W = slice(0, 3), slice(3, 6), slice(6, 12), slice(8, 12), slice(12, 17), slice(12, 15)
 _ROWS = 17
+_W_ROWS = np.array([0, 1, 2, 0, 1])  # ω's components in its five-row layout
 
 
 def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, ws: Workspace) -> None:
@@ -35,16 +36,16 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
     if len(lin) != len(ang):  # one per ball, the other shared
         lin, ang = np.broadcast_to(lin, (n, 3)), np.broadcast_to(ang, (n, 3))
     per_ball = len(lin) > 1
-    # the v and ω parts of acc·(h/6): the six k's added one by one, as ``rk4`` does
-    dv, dw = lin + lin, ang + ang
+    # the v and ω parts of acc·(h/6): the six k's added one by one, as ``rk4`` does (v and ω side by
+    # side, the same sums for each)
+    both = np.concatenate((lin, ang), axis=1)
+    d = both + both
     for _ in range(4):
-        dv += lin
-        dw += ang
-    dv *= sixth
-    dw *= sixth
-    spun_up = (ang != 0.0).any(axis=1)
-    ang5 = ang[:, [0, 1, 2, 0, 1]]  # in ω's five-row layout
-    lin_half, lin_h, ang_half, ang_h = lin * half, lin * h, ang5 * half, ang5 * h
+        d += both
+    d *= sixth
+    dv, dw = d[:, :3], d[:, 3:]
+    lin_half, lin_h = lin * half, lin * h
+    ang_half = ang_h = None  # ω's trial increments, made when some ball spins
     cols = ws.get("rk4 columns", (_ROWS, RK4_CHUNK))
     scratch = ws.get("rk4 scratch", (5, 3, RK4_CHUNK))  # acc_x, k2_x (then k4_x), three for _dq
     omegas = ws.get("rk4 omega", (2, 5, RK4_CHUNK))  # trial ω for stages 2–3 and for stage 4
@@ -57,8 +58,6 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
         t = cols[:, :m]
         np.copyto(t[0:6], rows[:, 0:6].T)
         np.copyto(t[8:15], rows[:, 6:13].T)
-        t[6:8] = t[9:11]
-        t[15:17] = t[12:14]
         x, v, q6, q, w5, w = t[_X], t[_V], t[_Q6], t[_Q], t[_W5], t[_W]
         acc, k2, *tmp = scratch[:, :, :m]
         # x: acc = k1 + k2 + k2 + k3 + k3 + k4 with k1 = v, k2 = k3 = lin·½h + v, k4 = lin·h + v
@@ -70,7 +69,12 @@ def rk4_constant(state: np.ndarray, lin: np.ndarray, ang: np.ndarray, h: float, 
         acc += k2
         acc *= sixth
         x += acc
-        if spun_up[part].any() or w.any() or not _keeps_orientation(q):
+        if np.count_nonzero(ang[part]) or np.count_nonzero(w) or not _keeps_orientation(q):
+            t[6:8] = t[9:11]  # the repeated rows of the layout
+            t[15:17] = t[12:14]
+            if ang_half is None:
+                ang5 = ang.take(_W_ROWS, axis=1)  # in ω's five-row layout
+                ang_half, ang_h = ang5 * half, ang5 * h
             # ω at the trial states: ang·½h + ω (stages 2 and 3) and ang·h + ω (stage 4)
             w_mid, w_end = omegas[:, :, :m]
             np.add(ang_half[part].T, w5, out=w_mid)
@@ -109,7 +113,7 @@ def _keeps_orientation(q: np.ndarray) -> bool:
     is q + (±0) = q, and so is the end q + acc·(h/6): adding a zero changes no finite value, except
     that −0 + +0 is +0. So q is kept when it is finite and holds no −0 (the identity holds +0s).
     """
-    return bool(np.isfinite(q).all()) and not (q.view(np.int64) == _NEGATIVE_ZERO).any()
+    return bool(np.isfinite(q).all()) and not np.count_nonzero(q.view(np.int64) == _NEGATIVE_ZERO)
 
 
 def _dq(q6: np.ndarray, w5: np.ndarray, out: np.ndarray, tmp: list[np.ndarray]) -> None:

@@ -52,7 +52,7 @@ def before_step(model: Model, state: State, sleep: Sleep, enabled: bool) -> None
         sleep.wake_all()
         return
     body = state.body
-    idx = np.flatnonzero(sleep.asleep)
+    idx = sleep.asleep.nonzero()[0]
     held = body[idx]
     moving = (held[:, V] != 0.0).any(axis=1) | (held[:, W] != 0.0).any(axis=1)
     moved = (np.hstack((held[:, X], held[:, Q])) != sleep.pose[idx]).any(axis=1)
@@ -137,7 +137,7 @@ def after_step(
         hit = sleep.asleep & ~still
         if hit.any():
             sleep.wake(hit)
-        idx = np.flatnonzero(sleep.asleep)
+        idx = sleep.asleep.nonzero()[0]
         body[idx, V] = 0.0
         body[idx, W] = 0.0
         body[idx, X] = sleep.pose[idx, :3]
@@ -154,7 +154,7 @@ def after_step(
     falls = ready & ~np.isin(label, restless)
     if not falls.any():
         return
-    idx = np.flatnonzero(falls)
+    idx = falls.nonzero()[0]
     _, group = np.unique(label[idx], return_inverse=True)
     body[idx, V] = 0.0
     body[idx, W] = 0.0

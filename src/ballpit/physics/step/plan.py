@@ -68,7 +68,9 @@ def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
     many = len(c) >= CROWD_PAIRS and model.crowd_limit != np.inf  # inf: always split at impacts
     # balls overlapping deeply (created at one point, or left so by a crowd) are pushed apart by the
     # soft step, whose planes hold, not jumped apart by positions
-    deep = model.crowd_limit != np.inf and (c.gap < -CROWD_OVERLAP * model.spheres.radius[c.a]).any()
+    deep = model.crowd_limit != np.inf and bool(
+        np.count_nonzero(c.gap < -CROWD_OVERLAP * model.spheres.radius[c.a])
+    )
     if deep:
         return True
     if not many and len(c) <= model.crowd_limit:  # too few pairs to be more meetings
@@ -78,7 +80,8 @@ def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
     meetings = np.count_nonzero((c.gap >= touching) & (ahead < touching))
     # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
     # soft step it landed in, not alternately in the two
-    return meetings > (0 if many else model.crowd_limit) or (many and bool((c.gap < touching).any()))
+    touch = many and bool(np.count_nonzero(c.gap < touching))
+    return meetings > (0 if many else model.crowd_limit) or touch
 
 
 def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray:
@@ -93,8 +96,8 @@ def _relative_motion(step: Step, c: ContactPoints, accel: np.ndarray) -> tuple[n
     """Each pair's relative velocity (against a moving plane's surface) and acceleration."""
     model = step.model
     v, acc = with_static(step.state.body[:, V]), with_static(accel)
-    dv = np.take(v, c.a, axis=0) - np.take(v, c.b, axis=0)  # rows by index: faster than v[c.a]
-    da = np.take(acc, c.a, axis=0) - np.take(acc, c.b, axis=0)
+    dv = v.take(c.a, axis=0) - v.take(c.b, axis=0)  # rows by index: faster than v[c.a]
+    da = acc.take(c.a, axis=0) - acc.take(c.b, axis=0)
     if model.moving_planes():  # relative to a moving plane's surface under the contact point
         on = c.kind == SPHERE_PLANE
         dv[on] -= moving_planes.surface_velocity(model, step.state, c.other[on], c.point[on])

@@ -37,39 +37,51 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
         if not first:
             contacts = measure(step, pairs)
         touching = contacts.subset(contacts.gap < step.touching)
-        with prof.stage(Stage.CONTACT_ROWS):
-            batch = rows.contact_rows(model, state, touching)
-        with prof.stage(Stage.PENETRATION):
-            moved = penetration.remove_penetration(model, state, touching, batch)
-        if moved:  # the interval is planned from where the balls are now, not from where they overlapped
-            contacts, touching, batch, pairs = _measure_again(step, motion, pairs, free, remaining, touching)
-        min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
-        with prof.stage(Stage.IMPACTS):  # arrivals bounce in waves; then slower approaches stop
-            impacts.in_waves(
-                model, state, touching, batch, step.restitution_threshold, min_normal_speed, step.events, now
-            )
-            impacts.stop_approaches(
-                model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
-            )
-        if len(touching):  # a separating contact is held where it is, not brought to rest (no work)
+        moved, push = False, None
+        if len(touching):  # else nothing to push apart, bounce, stop or hold: those stages are skipped
+            with prof.stage(Stage.CONTACT_ROWS):
+                batch = rows.contact_rows(model, state, touching)
+            with prof.stage(Stage.PENETRATION):
+                moved = penetration.remove_penetration(model, state, touching, batch)
+            if moved:  # the interval is planned from where the balls are now, not where they overlapped
+                contacts, touching, batch, pairs = _measure_again(
+                    step, motion, pairs, free, remaining, touching
+                )
+            min_normal_speed = np.zeros(len(touching))  # touching contacts may not close at all
+            with prof.stage(Stage.IMPACTS):  # arrivals bounce in waves; then slower approaches stop
+                impacts.in_waves(
+                    model,
+                    state,
+                    touching,
+                    batch,
+                    step.restitution_threshold,
+                    min_normal_speed,
+                    step.events,
+                    now,
+                )
+                impacts.stop_approaches(
+                    model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
+                )
+            # a separating contact is held where it is, not brought to rest (no work)
             min_normal_speed = resting.workless_targets(batch, state, model.integrator.bend)
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, forces)
-        with prof.stage(Stage.RESTING_SOLVE):
-            push = resting.resting_forces(
-                model,
-                state,
-                touching,
-                batch,
-                free,
-                ang,
-                remaining,
-                dt,
-                min_normal_speed,
-                step.warm,
-                step.events,
-                now,
-            )
+        if len(touching):
+            with prof.stage(Stage.RESTING_SOLVE):
+                push = resting.resting_forces(
+                    model,
+                    state,
+                    touching,
+                    batch,
+                    free,
+                    ang,
+                    remaining,
+                    dt,
+                    min_normal_speed,
+                    step.warm,
+                    step.events,
+                    now,
+                )
         lin = free if push is None else free + push.lin
         # The first interval's free path was checked against the boxes when the pairs were taken; a
         # path bent by a bounce or a contact force may leave them, and then the pairs are found again
@@ -113,7 +125,7 @@ def _measure_again(
             pairs = step.pairs.renew(model, state, remaining, ahead, free, free, motion.awake)
     contacts = measure(step, pairs)
     met = (contacts.gap < step.touching) & ~np.isin(contacts.keys(), touching.keys())
-    if met.any():
+    if np.count_nonzero(met):
         touching = ContactPoints.concatenate([touching, contacts.subset(met)])
     with prof.stage(Stage.CONTACT_ROWS):
         batch = rows.contact_rows(model, state, touching)
