@@ -12,7 +12,9 @@ y, RK2 at 1/60 s, so the total energy may only stay as it is (up to rounding):
 prints the first step whose total energy rose above the start's. The rise comes in an interval integrated
 with the resting solve's constant forces: a touching contact that is separating slowly at the
 interval's start while gravity closes it is held at v_n = 0 at the end, and the constant push does
-work J·(v_n0 + v_n1)/2 > 0 on the way.
+work J·(v_n0 + v_n1)/2 > 0 on the way. Since the resting solve lets such a contact end closing at v_n0
+(``resting.workless_targets``) it prints nothing: the energy never rises (+0.017 J and +2.6e-7 J
+before; tests/physics/test_resting.py holds both scenes).
 """
 
 import numpy as np

@@ -746,6 +746,42 @@ def _energy_scale(world: ballpit.World, half: float) -> float:
     return world.kinetic_energy() + float(np.sum(world.spheres.masses)) * g * 2.0 * half + 1e-300
 
 
+# Found by the long search of the wider strategies (2026-12-06, seed 301, shrunk): 33 balls of 6.25 cm
+# (10 g to 1 kg) at rest, all at the centre of an elastic frictionless 2 m box but one a radius beside
+# them, RK2 at 1/60 s: in step 7, split at impacts and integrated in one interval under the resting
+# solve's constant forces, the energy rises by 3.07 J (of 348 J); main before the resting solve's
+# no-work targets gained 4.0 J by step 17. Not fixed yet: kept as an expected failure, so it is
+# flagged when it passes.
+_MIXED = (0.01, 0.01, 0.01, 0.01, 0.015625, 0.03125, 0.01, *[1.0] * 17, *[0.0625] * 8, 0.125)
+COINCIDENT_MIXED_MASSES = Turned(
+    gravity=(0.0, -9.81, 0.0),
+    integrator="rk2",
+    dt=1 / 60,
+    positions=((0.0625, 0.0, 0.0), *[_Z] * (len(_MIXED) - 1)),
+    velocities=(_Z,) * len(_MIXED),
+    radii=(0.0625,) * len(_MIXED),
+    masses=_MIXED,
+    restitution=1.0,
+    half=1.0,
+    turn=_Z,
+    squares=False,
+    wall_restitution=1.0,
+    wall_friction=0.0,
+    steps=20,
+)
+
+# The same search (seed 302, shrunk): 40 balls of 6.25 cm and 1 kg at rest at the centre of the same
+# box, RK2 at 1/60 s: in step 14, taken whole (crowded), the energy rises by 28.6 J (of 785 J), on
+# main too. Not fixed yet: kept as an expected failure.
+COINCIDENT_FORTY = replace(
+    COINCIDENT_MIXED_MASSES,
+    positions=(_Z,) * 40,
+    velocities=(_Z,) * 40,
+    radii=(0.0625,) * 40,
+    masses=(1.0,) * 40,
+)
+
+
 def check_turned_box(box: Turned) -> None:
     """Run ``box``: after every step no state is non-finite, no ball's centre is beyond a wall, and an
     elastic frictionless box (integrated exactly) gains no energy beyond rounding."""
@@ -789,6 +825,8 @@ def test_no_ball_pressed_into_an_edge_or_corner_leaves_a_turned_box(box):
 
 
 @WIDE
+@example(COINCIDENT_MIXED_MASSES).xfail(raises=AssertionError, reason="energy rises by 3.07 J in step 7")
+@example(COINCIDENT_FORTY).xfail(raises=AssertionError, reason="energy rises by 28.6 J in step 14")
 @given(fast_in_turned_squares())
 def test_no_ball_at_a_thousand_metres_a_second_leaves_a_turned_box_of_squares(box):
     check_turned_box(box)

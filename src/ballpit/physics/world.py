@@ -283,20 +283,17 @@ class World:
 
         The stages, as docs/architecture.md draws them (step/): refuse what cannot be stepped; wake
         what was moved, collide, wake what the awake balls reach and collide again; the crowd test
-        plans the step; take it as a soft frame (retried with more substeps) or split at every impact;
-        still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
+        plans the step; take it as a soft frame (retried with more substeps) or split at every impact,
+        and again from its start if it struck a sleeping ball; still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
         the step's time per stage.
         """
         step = pipeline.prepare(
             self.model, self.parts, self._workspace, dt, self._good_planes, self._good_balls
         )
-        awake = pipeline.wake(step)
-        plan = pipeline.plan(step, awake.collision, awake.motion)
-        checkpoint = Checkpoint.of(self.parts, balls_later=True)  # the one undo (balls: when changed)
-        taken = pipeline.solve(step, awake, plan, checkpoint)
-        pipeline.settle(step, awake)
-        record = pipeline.finish(step, checkpoint, plan, len(awake.collision.pairs))
-        self._after_step(step, taken)
+        taken = pipeline.take(step)  # wake, plan, checkpoint, solve: again while a sleeper was struck
+        pipeline.settle(taken.step, taken.awake)
+        record = pipeline.finish(taken.step, taken.checkpoint, taken.plan, len(taken.awake.collision.pairs))
+        self._after_step(taken.step, taken.strategy)
         return record
 
     def _after_step(self, step: pipeline.Step, taken: pipeline.Strategy) -> None:

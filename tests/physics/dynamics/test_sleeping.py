@@ -248,3 +248,27 @@ def test_the_bundled_pile_never_gains_energy_as_it_lands_settles_sleeps_and_is_w
     for _ in range(90):
         assert world.kinetic_energy() + world.potential_energy() <= woken + 1e-12 * abs(woken), world.time
         world.step(dt)
+
+
+def test_a_sleeping_ball_struck_inside_a_step_is_woken_and_takes_the_strikers_momentum():
+    """Three equal 1 kg balls on an elastic frictionless floor along x: A and B touching, S 5 cm past
+    B. All sleep; then A is set moving at 6 m/s. A passes its speed to B at once (equal masses,
+    e = 1), and B, 5 cm from S, strikes S 8 ms into the same 1/60 s step, beyond the
+    reach the step's start foresaw (B was at rest then). Head-on between equal masses with e = 1 the
+    struck ball leaves with the striker's speed and the striker stops: x momentum 6 kg·m/s, all of
+    it S's. Held as a wall, S would throw B back into A."""
+    world = ballpit.World(sleep=True)
+    world.add_plane(restitution=1.0, friction=0.0)
+    r, v = 0.15, 6.0
+    x = [0.0, 2 * r, 4 * r + 0.05]  # A, B touching; S 5 cm beyond B, out of A's reach 2·v·dt = 0.2 m
+    world.add_spheres([(xi, r, 0.0) for xi in x], radius=r, mass=1.0, restitution=1.0, friction=0.0)
+    for _ in range(120):
+        world.step(1 / 60)
+    assert world.asleep.all()
+    world.spheres[0].velocity = (v, 0.0, 0.0)
+    world.step(1 / 60)
+    vx = world.spheres.velocities[:, 0]
+    assert not world.asleep[2]
+    assert vx.sum() == pytest.approx(v, rel=1e-9)  # 1 kg each: the x momentum is kept
+    assert vx[2] == pytest.approx(v, rel=1e-6)  # the struck ball leaves with the striker's speed
+    assert np.abs(vx[:2]).max() < 1e-6 * v  # and the striker and the first ball stop

@@ -85,6 +85,27 @@ def resting_forces(
     return ConstantPerBall((v[:-1] - v_free[:-1]) / h, (w[:-1] - w_free[:-1]) / h)
 
 
+def workless_targets(rows: ContactRows, state: State, bend: float) -> np.ndarray:
+    """Each touching contact's least normal speed at the interval's end: 0, or for a contact already
+    separating at v_n0 > 0, the closing speed at which it ends the interval where it began.
+
+    A constant force moves a contact along its normal by h·((1 − b/2)·v_n0 + (b/2)·v_n1) on a path of
+    bend b (``hold_by_planes``), and the solve's impulse J does that displacement's work. Brought to
+    v_n1 = 0, a slowly separating contact that gravity closes rises h·(1 − b/2)·v_n0 under a pushing
+    force: work J·v_n0/2 > 0 for RK2 and RK4, energy a closed elastic box gains. Held at
+    v_n1 = −v_n0·(2 − b)/b it ends where it began, and the force does no work. Explicit Euler
+    (b = 0) moves by v_n0 whatever v_n1 is, so its targets stay 0, and so do a moving plane's
+    contacts: the plane does work of its own, and a turning one is not where it was at the end.
+    """
+    if bend == 0.0:
+        return np.zeros(len(rows))
+    vn0 = rows.normal_speeds(with_static(state.body[:, V]))
+    target = np.minimum(vn0 * ((0.5 * bend - 1.0) / (0.5 * bend)), 0.0)
+    if rows.moving:
+        target[(rows.surface != 0.0).any(axis=1) | (rows.spin != 0.0).any(axis=1)] = 0.0
+    return target
+
+
 def hold_by_planes(
     rows: ContactRows,
     gap: np.ndarray,

@@ -162,6 +162,16 @@ class EventLog:
             self.add(time, contacts, keys, impulse * fraction)
             self._pending = None
 
+    def balls_reached(self, balls: np.ndarray) -> np.ndarray:
+        """Which of ``balls`` (a mask over the balls) an impulse recorded so far reached through a
+        ball–ball contact (a mask)."""
+        out = np.zeros(len(balls) + 1, bool)
+        for _, c, _, _ in self._parts:
+            pair = c.kind == SPHERE_SPHERE
+            out[c.a[pair]] = True
+            out[c.other[pair]] = True
+        return out[:-1] & balls
+
     def record(self) -> ContactRecord:
         if not self._parts:
             return ContactRecord.empty()

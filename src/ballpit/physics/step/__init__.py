@@ -1,6 +1,7 @@
 """A step as a pipeline of typed stages (docs/architecture.md draws it; ``World.step`` reads as it):
 
-    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> settle -> finish
+    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> struck -> settle
+        -> finish
 
 - ``prepare``: refuse what cannot be stepped; the step's settings and outputs (``Step``).
 - ``wake`` (sleep.py): wake what was moved by hand, collide (collide.py: the kept pairs and the
@@ -8,6 +9,8 @@
 - ``plan`` (plan.py): the crowd test, split at impacts or a soft frame of n substeps.
 - ``solve``: the soft frame (soft.py, softstep.py), tried with more substeps while it cannot keep its
   promises, else the step split at every impact (split.py).
+- ``struck`` (sleep.py): an impulse that reached a sleeping ball (met by a path no contact foresaw)
+  sends ``World.step`` back to the checkpoint, with that ball's island awake, to take the step again.
 - ``settle`` (sleep.py): still islands fall asleep.
 - ``finish``: undo a step that made anything non-finite; the time, the record and the profile.
 
@@ -20,6 +23,7 @@ undo both restore it.
 from __future__ import annotations
 
 from time import perf_counter
+from typing import NamedTuple
 
 from ..core import steppable, validation
 from ..core.contacts import ContactRecord, EventLog
@@ -31,9 +35,23 @@ from .checkpoint import Checkpoint, Parts
 from .collide import measure
 from .context import Step
 from .plan import Plan, Strategy, plan
-from .sleep import Awake, settle, wake
+from .sleep import Awake, settle, struck, wake
 
-__all__ = ["Awake", "Plan", "Step", "Strategy", "finish", "plan", "prepare", "settle", "solve", "wake"]
+__all__ = [
+    "Awake",
+    "Plan",
+    "Step",
+    "Strategy",
+    "Taken",
+    "finish",
+    "plan",
+    "prepare",
+    "settle",
+    "solve",
+    "struck",
+    "take",
+    "wake",
+]
 
 
 def prepare(
@@ -71,6 +89,33 @@ def solve(step: Step, awake: Awake, chosen: Plan, checkpoint: Checkpoint) -> Str
         contacts = collision.take()
     split.split_at_impacts(step, awake.motion, contacts, collision.pairs)
     return Strategy.SPLIT
+
+
+class Taken(NamedTuple):
+    """A step solved (``take``): the step as last taken, what woke, its plan, its undo, how it went."""
+
+    step: Step
+    awake: Awake
+    plan: Plan
+    checkpoint: Checkpoint
+    strategy: Strategy
+
+
+def take(step: Step) -> Taken:
+    """wake -> plan -> checkpoint -> solve; while the solve's impulses reached a sleeping ball (held
+    as a wall, it took no momentum: ``struck``), back to the checkpoint with that ball's island awake,
+    and the step taken again from its start. Each retry wakes at least one island, so it ends."""
+    while True:
+        awake = wake(step)
+        chosen = plan(step, awake.collision, awake.motion)
+        checkpoint = Checkpoint.of(step.parts, balls_later=True)  # the one undo (balls: when changed)
+        strategy = solve(step, awake, chosen, checkpoint)
+        hit = struck(step)
+        if hit is None:
+            return Taken(step, awake, chosen, checkpoint, strategy)
+        checkpoint.restore(step.parts)
+        step.state.sleep.wake(hit)
+        step = step.again()
 
 
 def finish(step: Step, checkpoint: Checkpoint, chosen: Plan, pairs: int) -> ContactRecord:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ..collision.pairs import PairCache
 from ..contact.warm_start import WarmStart
@@ -46,6 +46,10 @@ class Step:
 
     def __post_init__(self) -> None:
         self.state, self.pairs, self.warm = self.parts.state, self.parts.pairs, self.parts.warm
+
+    def again(self) -> Step:
+        """The same step to be taken again from its start: nothing done yet (its profile goes on)."""
+        return replace(self, events=EventLog(), intervals=0)
 
 
 def integrate_interval(step: Step, forces: list[ForceTerm], push: ForceTerm | None, h: float) -> None:

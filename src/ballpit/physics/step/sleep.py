@@ -58,6 +58,20 @@ def wake(step: Step) -> Awake:
     return Awake(motion, collision, links)
 
 
+def struck(step: Step) -> np.ndarray | None:
+    """The sleeping balls a contact impulse reached in the step just solved (a mask), or None.
+
+    Only the islands an awake ball touches or could reach at the step's start are woken, so these were
+    met by a path no contact foresaw (a ball bounced towards them inside the step). Solved as fixed
+    walls (a sleeping ball has no inverse mass), they took no momentum: their islands are woken and
+    the step solved again from its start."""
+    sleep = step.state.sleep
+    if not sleep.any:
+        return None
+    hit = step.events.balls_reached(sleep.asleep)
+    return hit if hit.any() else None
+
+
 def settle(step: Step, awake: Awake) -> None:
     """Still islands fall asleep (their pairs' warm start put aside); a sleeping ball the step left
     moving wakes."""

@@ -62,6 +62,8 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
                 impacts.stop_approaches(
                     model, state, touching, batch, min_normal_speed, step.events, now, interval=remaining
                 )
+            # a separating contact is held where it is, not brought to rest (no work)
+            min_normal_speed = resting.workless_targets(batch, state, model.integrator.bend)
         if not first or len(touching):  # velocities may have changed since the step began
             free, ang = free_acceleration(state.body, forces)
         if len(touching):
