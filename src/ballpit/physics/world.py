@@ -284,8 +284,8 @@ class World:
         The stages, as docs/architecture.md draws them (step/): refuse what cannot be stepped; wake
         what was moved, collide, wake what the awake balls reach and collide again; the crowd test
         plans the step; take it as a soft frame (retried with more substeps) or split at every impact,
-        and again from its start if it struck a sleeping ball; still islands fall asleep; undo a step that made anything non-finite. ``profile`` then holds
-        the step's time per stage.
+        and again from its start if it struck a sleeping ball; still islands fall asleep; undo a step
+        that made anything non-finite. ``profile`` then holds the step's time per stage.
         """
         step = pipeline.prepare(
             self.model, self.parts, self._workspace, dt, self._good_planes, self._good_balls
