@@ -292,3 +292,41 @@ def test_bench_refuses_a_timeout_too_long_for_the_clock(capsys):
     assert exit_info.value.code == 2
     assert "argument --timeout: must be at most 1e+06 seconds, got '1e308'" in err
     assert len(err.strip().splitlines()) == 1
+
+
+_WRAPPED_INTERRUPT = """
+import importlib.abc, os, signal, sys
+
+
+class WrapsInterrupts(importlib.abc.MetaPathFinder):
+    # What NumPy's C extension does when Ctrl+C lands in its import of datetime: the
+    # KeyboardInterrupt comes out as an ImportError.
+    def find_spec(self, name, path, target=None):
+        if name == "ballpit.cli.commands":
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+            except KeyboardInterrupt as e:
+                raise ImportError("PyCapsule_Import could not import module datetime") from e
+        return None
+
+
+sys.meta_path.insert(0, WrapsInterrupts())
+from {module} import {function} as main
+sys.exit(main(["check", "slopes"]))
+"""
+
+
+def test_ctrl_c_that_a_library_turns_into_an_import_error_still_exits_130_in_one_line():
+    spec = next(e for e in importlib.metadata.entry_points(group="console_scripts") if e.name == "ballpit")
+    code = _WRAPPED_INTERRUPT.format(module=spec.module, function=spec.attr)
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert (r.returncode, r.stderr) == (cli.EXIT_INTERRUPTED, "ballpit: interrupted\n")
+
+
+def test_an_import_error_with_no_stop_signal_is_not_taken_for_one():
+    code = _WRAPPED_INTERRUPT.format(module="ballpit.cli", function="main").replace(
+        "os.kill(os.getpid(), signal.SIGINT)",
+        "raise ImportError('broken install')",
+    )
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "ImportError: broken install" in r.stderr

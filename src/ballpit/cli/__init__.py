@@ -26,6 +26,7 @@ class Terminated(BaseException):
 
 
 _STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+_stopped_by: list[int] = []  # the stop signal that came, once one has
 
 
 def _on_stop_signal(signum: int, frame: object) -> None:
@@ -33,6 +34,7 @@ def _on_stop_signal(signum: int, frame: object) -> None:
     for name in _STOP_SIGNALS:
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_IGN)
+    _stopped_by.append(signum)
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise Terminated(signum)
@@ -97,6 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     143 with one line, never a traceback. A closed pipe (``| head``) ends the run quietly (141); a closed
     or full stdout (``>&-``, ``> /dev/full``) with one line (1).
     """
+    _stopped_by.clear()
     previous = _install_stop_handlers()
     stdout = sys.stdout
     _keep_descriptor_one_taken(stdout)
@@ -108,11 +111,9 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.flush()  # here, not at exit, so a closed pipe or a full disk is caught below
         return status
     except KeyboardInterrupt:
-        print("ballpit: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _stopped(signal.SIGINT)
     except Terminated as e:
-        print(f"ballpit: stopped by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
+        return _stopped(e.signum)
     except BrokenPipeError:
         _silence_stdout()
         return EXIT_BROKEN_PIPE
@@ -120,10 +121,25 @@ def main(argv: list[str] | None = None) -> int:
         print(f"ballpit: cannot write to stdout: {e.reason}", file=sys.stderr)
         _silence_stdout()
         return EXIT_FAILED
+    except Exception:
+        # A library may wrap the KeyboardInterrupt raised inside its import (NumPy's C extension turns
+        # it into an ImportError): after a stop signal, whatever unwound the run is that signal.
+        if not _stopped_by:
+            raise
+        return _stopped(_stopped_by[0])
     finally:
         sys.stdout = stdout
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+
+
+def _stopped(signum: int) -> int:
+    """Say which stop signal ended the run; its exit status (130 for Ctrl+C, 128 + the signal's number)."""
+    if signum == signal.SIGINT:
+        print("ballpit: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(f"ballpit: stopped by {signal.Signals(signum).name}", file=sys.stderr)
+    return 128 + signum
 
 
 def _keep_descriptor_one_taken(stdout: object | None) -> None:
