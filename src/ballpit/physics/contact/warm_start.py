@@ -98,9 +98,8 @@ class WarmStart:
         held = np.zeros(len(keys))
         if len(self.keys) == 0:
             return held
-        pos = np.minimum(np.searchsorted(self.keys, keys), len(self.keys) - 1)
-        found = self.keys[pos] == keys
-        held[found] = self.apart[pos[found]]
+        found, src = self._found(keys)
+        held[found] = self.apart[src]
         return held
 
     def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
