@@ -7,7 +7,7 @@ import numpy as np
 
 from ..core import exact
 from ..core.contacts import ContactPoints
-from ..core.settings import CONTACT_HERTZ, DAMPING_RATIO, PLANE_STIFFNESS, SOFT_RATE_CAP
+from ..core.settings import CONTACT_HERTZ, DAMPING_RATIO, PLANE_STIFFNESS, SOFT_RATE_CAP, SWEEP_CHUNK
 from ..core.state import Q, State, V, W, X
 from ..dynamics.forces import ForceTerm, constant_acceleration, forces_of
 from ..dynamics.model import Model
@@ -72,11 +72,9 @@ class SoftFrame:
         # are found again when needed (``keys``, ``came_with``, ``start_speeds``), not held through the
         # substeps (24 bytes a contact each)
         keys = c.keys()
-        imp = warm.impulses(keys, c.normal, h)
+        self.tangential = np.zeros((2, 3, kc))
+        self.normal = warm.impulses(keys, c.normal, h, self.tangential).normal
         self.apart = warm.apart_of(keys)
-        self.normal = imp.normal
-        self.tangential = np.ascontiguousarray(np.stack((imp.friction, imp.rolling)).transpose(0, 2, 1))
-        del imp
         self.total = np.zeros(kc)
         self.least = c.gap.copy()
         self.farthest, self.largest = np.zeros(m), np.zeros(m)
@@ -106,9 +104,17 @@ class SoftFrame:
         """s = s₀ + n·(Δx_a − Δx_b): each contact's separation from the balls' moved positions (and a
         moving plane's surface, moved by its speed along n for ``t``)."""
         d = self.x - self.x0
-        s = self.c.gap + exact.dot_cols(
-            np.take(d, self.ends_a, axis=1) - np.take(d, self.ends_b, axis=1), self.n
-        )
+        k = len(self.ends_a)
+        if k <= SWEEP_CHUNK:
+            s = self.c.gap + exact.dot_cols(
+                np.take(d, self.ends_a, axis=1) - np.take(d, self.ends_b, axis=1), self.n
+            )
+        else:  # SWEEP_CHUNK contacts at a time: the (3, chunk) gathers of a chunk, not of all
+            s = np.empty(k)
+            for lo in range(0, k, SWEEP_CHUNK):
+                part = slice(lo, min(lo + SWEEP_CHUNK, k))
+                moved = np.take(d, self.ends_a[part], axis=1) - np.take(d, self.ends_b[part], axis=1)
+                np.add(self.c.gap[part], exact.dot_cols(moved, self.n[:, part]), out=s[part])
         if self.surface_n is not None:
             s -= self.surface_n * t
         return s

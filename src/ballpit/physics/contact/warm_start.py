@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import exact
+from ..core.settings import SWEEP_CHUNK
 from ..core.state import shallow_copy
 from .contact_model import Impulses
 
@@ -46,17 +47,27 @@ class WarmStart:
             normal[found] = self.forces.normal[src] * h
         return normal
 
-    def impulses(self, keys: np.ndarray, normal: np.ndarray, h: float) -> Impulses:
-        """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``."""
-        imp = Impulses.zeros(len(keys))
+    def impulses(
+        self, keys: np.ndarray, normal: np.ndarray, h: float, tangential: np.ndarray | None = None
+    ) -> Impulses:
+        """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``; the friction
+        and rolling impulses into ``tangential`` when given (zeros, (2, 3, K): ``jacobi.sweeps``' block)
+        as views of its rows, with no (K, 3) arrays of their own."""
+        if tangential is None:
+            imp = Impulses.zeros(len(keys))
+        else:
+            imp = Impulses(np.zeros(len(keys)), tangential[0].T, tangential[1].T)
         if len(self.keys) == 0:
             return imp
         found, src = self._found(keys)
         imp.normal[found] = self.forces.normal[src] * h
-        friction = self.forces.friction[src] * h
-        n = normal[found]
-        # onto today's tangent plane
-        imp.friction[found] = friction - exact.dot_rows(friction, n)[:, None] * n
+        if len(src) <= SWEEP_CHUNK:
+            imp.friction[found] = _on_tangent_plane(self.forces.friction[src] * h, normal[found])
+        else:  # SWEEP_CHUNK pairs at a time: the (chunk, 3) temporaries of a chunk, not of all
+            rows = np.flatnonzero(found)
+            for lo in range(0, len(src), SWEEP_CHUNK):
+                to, at = rows[lo : lo + SWEEP_CHUNK], src[lo : lo + SWEEP_CHUNK]
+                imp.friction[to] = _on_tangent_plane(self.forces.friction[at] * h, normal[to])
         imp.rolling[found] = self.forces.rolling[src] * h
         return imp
 
@@ -105,6 +116,11 @@ class WarmStart:
     def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
         """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
         self.apart = apart[np.argsort(keys)]
+
+
+def _on_tangent_plane(friction: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """The friction impulses (rows) onto today's tangent planes, of normals ``n``: f − (f·n)·n."""
+    return friction - exact.dot_rows(friction, n)[:, None] * n
 
 
 def _divided(x: np.ndarray, h: float) -> np.ndarray:

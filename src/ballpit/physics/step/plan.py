@@ -75,13 +75,14 @@ def crowded(step: Step, c: ContactPoints, accel: np.ndarray) -> bool:
         return True
     if not many and len(c) <= model.crowd_limit:  # too few pairs to be more meetings
         return False
+    # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
+    # soft step it landed in, not alternately in the two (and a pile at rest needs no meetings counted)
+    if many and np.count_nonzero(c.gap < touching):
+        return True
     dv, da = _relative_motion(step, c, accel)
     ahead = c.gap + np.einsum("ij,ij->i", dv * dt + 0.5 * dt * dt * da, c.normal)
     meetings = np.count_nonzero((c.gap >= touching) & (ahead < touching))
-    # among many pairs (a pile) a touching contact makes the step crowded too: a pile rests in the
-    # soft step it landed in, not alternately in the two
-    touch = many and bool(np.count_nonzero(c.gap < touching))
-    return meetings > (0 if many else model.crowd_limit) or touch
+    return meetings > (0 if many else model.crowd_limit)
 
 
 def speculative_reach(step: Step, c: ContactPoints, accel: np.ndarray) -> np.ndarray:
