@@ -83,8 +83,9 @@ def sweeps(
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
     and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
-    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses. The ``tangential`` given
-    (a contiguous (2, 3, K) block) is taken as scratch by a full sweep: its values are not kept.
+    accumulated normal and tangential ((2, 3, K): friction, rolling) impulses. The ``normal`` and
+    ``tangential`` given (a contiguous (2, 3, K) block) are taken as scratch by a full sweep: their
+    values are not kept.
 
     Every ``friction_every``-th sweep and the last also update friction and rolling resistance (None:
     normal impulses alone). ``m_n`` and ``give`` make the normal soft (``contact_model.normal_impulse``;
@@ -213,11 +214,12 @@ def _full_sweep(
     velocity change it made at any contact (m/s).
 
     The new impulses are formed SWEEP_CHUNK contacts at a time (``_full_chunk``) into ``motion``
-    (the new tangential impulses) and the changes into the old impulses' block, which then is the
-    next sweep's ``motion``: two (2, 3, K) blocks, and the temporaries of one chunk."""
+    (the new tangential impulses) and the changes into the old impulses' blocks, which then is the
+    next sweep's ``motion``: two (2, 3, K) blocks, the old and new normal impulses, and the
+    temporaries of one chunk."""
     k = c.k
     new = np.empty(k)
-    d_n = np.empty(k)
+    d_n = normal  # each chunk's changes where its old impulses were, once read
     change = 0.0
     for lo in range(0, k, SWEEP_CHUNK):
         part = slice(lo, min(lo + SWEEP_CHUNK, k))

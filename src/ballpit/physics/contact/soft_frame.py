@@ -80,6 +80,30 @@ class SoftFrame:
         self.farthest, self.largest = np.zeros(m), np.zeros(m)
         self.lo, self.hi = x[:, live].copy(), x[:, live].copy()
 
+    def sweeps(
+        self, target: np.ndarray, count: int, m_n: np.ndarray | None = None, give: np.ndarray | None = None
+    ) -> None:
+        """``count`` Jacobi sweeps of the soft normal update towards ``target`` (``jacobi.sweeps``,
+        friction and rolling in the last), from the frame's impulses to its new ones. The sweeps take
+        the old impulses as scratch, and the frame lets go of them first, so that the old normal
+        impulses go after the first sweep instead of being held through the rest (K floats)."""
+        self.normal, self.tangential = jacobi.sweeps(
+            self.k,
+            self.vw,
+            self._handed_over(),
+            self.tangential,
+            target,
+            count,
+            friction_every=count,
+            m_n=m_n,
+            give=give,
+        )
+
+    def _handed_over(self) -> np.ndarray:
+        """The normal impulses, no longer held by the frame."""
+        normal, self.normal = self.normal, None
+        return normal
+
     def keys(self) -> np.ndarray:
         """The pairs' keys (``ContactPoints.keys``)."""
         return self.c.keys()

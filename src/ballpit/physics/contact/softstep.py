@@ -149,9 +149,7 @@ def solve(f: SoftFrame, i: int) -> None:
     del speculative
     give *= k.m_n
     give *= k.whole
-    f.normal, f.tangential = jacobi.sweeps(
-        k, vw, f.normal, f.tangential, target, SOLVE_SWEEPS, friction_every=SOLVE_SWEEPS, m_n=m_n, give=give
-    )
+    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give)
 
 
 def integrate_positions(f: SoftFrame) -> None:
@@ -175,7 +173,11 @@ def relax(f: SoftFrame, i: int) -> None:
     s = f.separation((i + 1) * f.h)
     np.minimum(f.least, s, out=f.least)
     target = np.where(s > 0.0, -s / f.h, 0.0)
-    f.normal, f.tangential = _soft_sweeps(f.k, f.vw, f.normal, f.tangential, target, 1.0, 0.0, RELAX_SWEEPS)
+    del s
+    # the soft update with mass scale 1 and no give, ΔP = m_n·(target − v_n): m_n·1 is m_n, and a give
+    # of 0·P takes nothing from a finite P (and P − 0 is P), so the split m_n alone, with no (K,) arrays
+    # of m_n·1 and 0·m_n·(1/m_n)
+    f.sweeps(target, RELAX_SWEEPS)
     f.total += f.normal
 
 
@@ -243,32 +245,3 @@ def store_impulses(
     warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
     # what moving apart reads of the rows: the bodies, the inverse masses and the planes' surfaces
     f.rows = replace(f.rows, **dict.fromkeys(_ROWS_DONE))
-
-
-def _soft_sweeps(
-    k: jacobi.ContactColumns,
-    vw: np.ndarray,
-    normal: np.ndarray,
-    tangential: np.ndarray,
-    target: np.ndarray,
-    scale: np.ndarray | float,
-    give: np.ndarray | float,
-    sweeps: int,
-) -> tuple[np.ndarray, np.ndarray]:
-    """``sweeps`` Jacobi sweeps of the soft normal update ΔP = m_n·scale·(target − v_n) − give·P (P ≥ 0);
-    the last one also updates friction (the Coulomb cone |P_t| ≤ μ·P_n) and rolling resistance
-    (|R| ≤ ρ·r·P_n). ``vw`` changes in place; returns the new accumulated impulses.
-
-    The spring's give, −give·P, is the unsplit contact's: ΔP = m_split·(scale·(target − v_n) −
-    give·P/m_whole), so a ball's share of a crowd does not make its contacts softer."""
-    return jacobi.sweeps(
-        k,
-        vw,
-        normal,
-        tangential,
-        target,
-        sweeps,
-        friction_every=sweeps,
-        m_n=k.m_n * scale,
-        give=give * k.m_n * k.whole,
-    )
