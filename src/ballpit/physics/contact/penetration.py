@@ -19,6 +19,7 @@ from ..core.settings import (
     OVERLAP_PER_RADIUS,
     PENETRATION_SWEEPS,
     PENETRATION_TOLERANCE,
+    SWEEP_CHUNK,
 )
 from ..core.state import State, X, with_static
 from ..dynamics.model import Model
@@ -72,10 +73,14 @@ def separate(
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
 
-    def along() -> np.ndarray:  # n·(x_a − x_b) per contact
-        d = n[0] * (x[0].take(ea) - x[0].take(eb))
-        d += n[1] * (x[1].take(ea) - x[1].take(eb))
-        d += n[2] * (x[2].take(ea) - x[2].take(eb))
+    def along() -> np.ndarray:  # n·(x_a − x_b) per contact, SWEEP_CHUNK contacts at a time
+        d = np.empty(k)
+        for lo in range(0, k, SWEEP_CHUNK):
+            part = slice(lo, lo + SWEEP_CHUNK)
+            a, b, out = ea[part], eb[part], d[part]
+            np.multiply(n[0, part], x[0].take(a) - x[0].take(b), out=out)
+            out += n[1, part] * (x[1].take(a) - x[1].take(b))
+            out += n[2, part] * (x[2].take(a) - x[2].take(b))
         return d
 
     start = along()

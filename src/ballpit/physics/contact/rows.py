@@ -34,8 +34,8 @@ class ContactRows:
     b: np.ndarray  # second ball, or the static row N for a plane
     normal: np.ndarray  # (K, 3), towards a
     # the lever arms (centre → contact point) are r_a = −radius_a·n and r_b = radius_b·n (``arm_lengths``)
-    radius_a: np.ndarray  # (K,) a's radius
-    radius_b: np.ndarray  # (K,) b's radius, zero for planes
+    radius_a: np.ndarray | None  # (K,) a's radius (None once the arms are made, ``forget_radii``)
+    radius_b: np.ndarray | None  # (K,) b's radius, zero for planes
     inv_mass_a: np.ndarray
     inv_mass_b: np.ndarray
     inv_inertia_a: np.ndarray
@@ -47,6 +47,8 @@ class ContactRows:
     spin: np.ndarray  # (K, 3) angular velocity of that surface (a turning plane's ω)
     moving: bool  # whether any contact has a moving surface (else surface and spin are zero)
     static: int  # the static world's row (the number of balls)
+    # |r_a| and |r_b| kept once the radii are let go (``forget_radii``); None: made from the radii
+    arms: tuple[np.ndarray, np.ndarray] | None = None
 
     def __len__(self) -> int:
         return len(self.a)
@@ -61,6 +63,8 @@ class ContactRows:
     def _arms(self) -> tuple[np.ndarray, np.ndarray]:
         """Every contact's |r_a| and |r_b|, formed once (the solves ask for them several times an
         interval; each row's length is the same whichever rows are asked for)."""
+        if self.arms is not None:
+            return self.arms
         n = self.normal
         a, b = exact.norm_rows(-self.radius_a[:, None] * n), exact.norm_rows(self.radius_b[:, None] * n)
         a.flags.writeable = b.flags.writeable = False
@@ -83,9 +87,18 @@ class ContactRows:
         """The contacts where ``mask`` holds."""
         kept = ("moving", "static")
         idx = take_indices(mask)
-        found = (*kept, "colours", "_arms")  # worked out from the rows, not rows themselves
-        fields = {k: v.take(idx, axis=0) for k, v in vars(self).items() if k not in found}
-        return ContactRows(**fields, moving=self.moving, static=self.static)
+        found = (*kept, "colours", "_arms", "arms")  # worked out from the rows, not rows themselves
+        fields = {
+            k: None if v is None else v.take(idx, axis=0) for k, v in vars(self).items() if k not in found
+        }
+        arms = None if self.arms is None else (self.arms[0].take(idx), self.arms[1].take(idx))
+        return ContactRows(**fields, moving=self.moving, static=self.static, arms=arms)
+
+    def forget_radii(self) -> None:
+        """Keep the lever arms' lengths (``arm_lengths``) and let go of the radii they are made of:
+        16 bytes a contact. Subsets and copies keep the lengths of their rows."""
+        self.arms = self._arms
+        self.radius_a = self.radius_b = None
 
 
 def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:

@@ -49,10 +49,13 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
     if not (made < -PENETRATION_TOLERANCE).any():
         return s
     made = np.where(made < 0.0, s - np.minimum(c.gap + MAX_PUSH * dt, -SLOP_RETURN * slop), made)
+    del slop
     part = np.flatnonzero(made < -SEPARATE_REACH * made.min())
     pos = with_static(body[:, X])
     # the contacts ``part``; every contact (a settled pile) as the frame holds them, not copies
     every = len(part) == len(made)
+    if every:
+        del part
     take = (lambda a: a) if every else (lambda a: a[part])
     # the normals laid out as (3, K) columns, as separate reads them (``c.normal`` is)
     normals = c.normal if every else np.take(c.normal.T, part, axis=1).T

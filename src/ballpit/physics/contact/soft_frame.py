@@ -43,6 +43,7 @@ class SoftFrame:
         n_balls = model.spheres.count
         self.rows = contact_rows(model, state, c)
         k = self.k = jacobi.ContactColumns(self.rows)
+        self.rows.forget_radii()  # the solve reads the arms' lengths (``k.ra``, ``k.rb``) alone
         body = state.body
         self.k_balls = k.balls
         m_dyn = int(np.searchsorted(k.balls, n_balls))  # the static row N, if there, is the last column

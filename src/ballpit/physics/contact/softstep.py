@@ -58,7 +58,16 @@ from .soft_frame import SoftFrame
 from .warm_start import WarmStart
 
 # the contact rows' columns no stage reads once the impulses are stored (``store_impulses``)
-_ROWS_DONE = ("radius_a", "radius_b", "inv_inertia_a", "inv_inertia_b", "restitution", "friction", "rolling")
+_ROWS_DONE = (
+    "radius_a",
+    "radius_b",
+    "arms",
+    "inv_inertia_a",
+    "inv_inertia_b",
+    "restitution",
+    "friction",
+    "rolling",
+)
 
 
 @dataclass

@@ -63,12 +63,13 @@ class WarmStart:
         imp.normal[found] = self.forces.normal[src] * h
         if len(src) <= SWEEP_CHUNK:
             imp.friction[found] = _on_tangent_plane(self.forces.friction[src] * h, normal[found])
-        else:  # SWEEP_CHUNK pairs at a time: the (chunk, 3) temporaries of a chunk, not of all
-            rows = np.flatnonzero(found)
-            for lo in range(0, len(src), SWEEP_CHUNK):
-                to, at = rows[lo : lo + SWEEP_CHUNK], src[lo : lo + SWEEP_CHUNK]
-                imp.friction[to] = _on_tangent_plane(self.forces.friction[at] * h, normal[to])
-        imp.rolling[found] = self.forces.rolling[src] * h
+            imp.rolling[found] = self.forces.rolling[src] * h
+            return imp
+        rows = np.flatnonzero(found)  # SWEEP_CHUNK pairs at a time: the (chunk, 3) temporaries of a chunk
+        for lo in range(0, len(src), SWEEP_CHUNK):
+            to, at = rows[lo : lo + SWEEP_CHUNK], src[lo : lo + SWEEP_CHUNK]
+            imp.friction[to] = _on_tangent_plane(self.forces.friction[at] * h, normal[to])
+            imp.rolling[to] = self.forces.rolling[at] * h
         return imp
 
     def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> None:
