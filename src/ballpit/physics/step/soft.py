@@ -80,6 +80,11 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     left = contacts.gaps().subset(~solved)
     del solved
     del contacts
+    # the points of the pairs between balls are made again for the record (``_points``), not held
+    # through the frame (24 bytes a contact); the rows of a moving plane read them
+    plane_points = None if model.moving_planes() else c.point[c.kind == SPHERE_PLANE]
+    if plane_points is not None:
+        c.point = None
     for substeps in [plan.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
@@ -91,6 +96,8 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
             break
     else:
         return False
+    if plane_points is not None:
+        c.point = _points(c, plane_points, checkpoint.state.body, model)
     step.events.add(now, c, c.keys(), frame.impulse)
     step.intervals += 1
     return True
@@ -228,3 +235,17 @@ def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) 
     if (~on_plane).any():
         gap[~on_plane] = geometry.sphere_sphere(x, radius, c.a[~on_plane], c.other[~on_plane])[0]
     return gap
+
+
+def _points(c: ContactPoints, plane_points: np.ndarray, before: np.ndarray, model: Model) -> np.ndarray:
+    """The contacts' points as the narrow phase measured them from the balls ``before`` the frame: the
+    plane contacts' as kept, each pair of balls' at the middle of its gap, x_j + n·(r_j + ½·gap), by the
+    same operations as ``geometry.sphere_sphere``."""
+    on_plane = c.kind == SPHERE_PLANE
+    point = np.empty((len(c), 3))
+    point[on_plane] = plane_points
+    pair = ~on_plane
+    j, gap = c.other[pair], c.gap[pair]
+    xj = before[:, X].take(j, axis=0)
+    point[pair] = xj + c.normal[pair] * (model.spheres.radius[j] + 0.5 * gap)[:, None]
+    return point
