@@ -64,10 +64,10 @@ def _measured(
             np.concatenate(pair) for pair in zip(first, geometry.sphere_sphere(x, radius, i, j), strict=True)
         )
     p = len(first[0])
-    x = np.ascontiguousarray(x)  # gathered rows come from a copy: taking from a view copies it each time
     whole = tuple(np.empty((p + len(i), *part.shape[1:])) for part in first)
     for out, part in zip(whole, first, strict=True):
         out[:p] = part
+    x = np.ascontiguousarray(x)  # gathered rows come from a copy: taking from a view copies it each time
     for lo in range(0, len(i), SWEEP_CHUNK):
         hi = min(lo + SWEEP_CHUNK, len(i))
         measured = geometry.sphere_sphere(x, radius, i[lo:hi], j[lo:hi])
