@@ -138,15 +138,18 @@ def ghosts_and_plot(workdir: Path) -> dict:
     steps = sim.timeline.history.current
     out: dict = {"steps": steps, "drifts": sim.timeline.drifts()}
     # the same drift, worked out headless: the run and plain copies under the other integrators
-    expected = {}
+    expected, before_last = {}, {}
     for name in INTEGRATOR_NAMES:
         world = bounce_world()
         e0 = world.kinetic_energy() + world.potential_energy()
         world.integrator = name
-        for _ in range(steps):
+        for step in range(steps):
+            if step == steps - 1:
+                before_last[name] = np.array(world.spheres.positions)
             world.step(DT)
         expected[name] = ((world.kinetic_energy() + world.potential_energy()) - e0) / abs(e0) * 100
     out["expected"] = expected
+    out["ghosts_in_a_process"] = sim.timeline.ghosts.remote and sim.ghost_host.child_cpu() > 0.0
     wd.pump(viewer, 1, dt=0.0)
     out["hud"] = viewer.hud.text
     out["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
@@ -162,10 +165,13 @@ def ghosts_and_plot(workdir: Path) -> dict:
     series = sim.timeline.energy.series()
     out["series"] = sorted(series)
     out["span"] = float(series["time"][-1] - series["time"][0])
-    ghost = sim.timeline.ghosts
-    # stepping back moves the ghosts too
+    # stepping back moves the ghosts too: the window draws them where the same runs were a step earlier
     wd.press(viewer, "LEFT")
-    out["ghost_steps_after_left"] = [g.current for g in ghost.histories.values()]
+    shown = viewer.shown
+    out["ghost_step_after_left"] = shown.ghost_step
+    out["ghosts_after_left_match"] = {
+        name: bool(np.array_equal(positions, before_last[name])) for name, positions, _, _ in shown.ghosts
+    }
     wd.press(viewer, "G")
     wd.pump(viewer, 1, dt=0.0)
     out["calls_off"] = [c.label for c in viewer.renderer.draws.calls]
@@ -284,13 +290,13 @@ def integrator_ghosts_part_ways(workdir: Path) -> dict:
         pixels, depth = viewer.camera.project(main, 640, 360)
         focal = 180 / np.tan(np.radians(viewer.camera.fov_y_degrees / 2))
         at: dict = {"time": float(sim.world.time), "drawn_radius": float(np.median(radius / depth * focal))}
-        for name, ghost in sim.timeline.ghost_worlds():
-            theirs = np.asarray(ghost.spheres.positions)
+        frame = sim.timeline.ghosts.frame_at(sim.timeline.history.current)
+        for name, theirs, _, _ in frame.bodies:
             ghost_pixels, _ = viewer.camera.project(theirs, 640, 360)
             at[name] = {
                 "metres": np.linalg.norm(theirs - main, axis=1).tolist(),
                 "pixels": np.linalg.norm(ghost_pixels - pixels, axis=1).tolist(),
-                "time": float(ghost.time),
+                "time": frame.time,
             }
         wd.pump(viewer, 1, dt=0.0)
         at["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]

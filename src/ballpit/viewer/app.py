@@ -356,6 +356,7 @@ class Viewer:
         self.physics_seconds = time.perf_counter() - started  # lockstep only: free, it is 0
         self.physics.deliver()
         shown = self.physics.shown
+        shown.resolve_ghosts()
 
         self.window.switch_to()
         width, height = self.window.get_framebuffer_size()
@@ -387,9 +388,9 @@ class Viewer:
         if self.interaction.held_ball is not None:
             return None
         c = self.camera
-        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset, width, height,
-                self.flags.contacts, self.flags.velocities, self.flags.trails, self.panel.width,
-                self.interaction.selected_plane, id(self.view_target))  # fmt: skip
+        return (id(shown), shown.ghost_step, tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset,
+                width, height, self.flags.contacts, self.flags.velocities, self.flags.trails,
+                self.panel.width, self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
     def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:
         """A held ball follows the pointer and a selected plane the held keys: the physics side does it
