@@ -304,9 +304,66 @@ def integrator_ghosts_part_ways(workdir: Path) -> dict:
     return out
 
 
+def ghosts_in_real_time(workdir: Path) -> dict:
+    """The viewer's own free run (wall-clock frames, the physics running ahead) with the ghosts on: the
+    step each frame draws the ghosts at against the step of the state it shows, then Esc, Esc while the
+    ghosts' process steps ahead: how long the window takes to close, and whether the process is gone."""
+    import time
+
+    from pyglet.window import key
+
+    world = bounce_world()
+    world.add_sphere(position=(1.0, 3.0, 0), radius=0.25, restitution=1.0, friction=0.0)
+    viewer = wd.open_viewer(size=(640, 360), world=world)
+    wd.press(viewer, "G")
+    wd.press(viewer, "X")
+    frames = []
+    end = time.perf_counter() + 3.0
+    while time.perf_counter() < end:
+        viewer.pump()
+        shown = viewer._drawn_shown  # the state the 3-D view was last drawn from
+        frames.append([shown.step, shown.ghost_step, len(shown.ghosts)])
+    out: dict = {"frames": frames, "calls": [[c.label, c.instances] for c in viewer.renderer.draws.calls]}
+    pid = viewer.sim.ghost_host.pid
+    out["pid_alive"] = not _gone(pid)
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    wd.pump(viewer, 2, dt=None)
+    pressed = time.perf_counter()
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    while not viewer.closed and time.perf_counter() - pressed < 10:
+        viewer.pump()
+    viewer.pump()
+    out["quit_seconds"] = time.perf_counter() - pressed
+    out["closed"] = viewer.closed
+    deadline = time.perf_counter() + 10
+    while not _gone(pid) and time.perf_counter() < deadline:
+        time.sleep(0.02)
+    out["pid_gone"] = _gone(pid)
+    return out
+
+
+def _gone(pid: int) -> bool:
+    """The process has exited (reaped, or a zombie)."""
+    import os
+
+    try:
+        os.waitpid(pid, os.WNOHANG)  # our child: reap it if it has ended
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
 SCENARIOS = {
     f.__name__: f
-    for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in, integrator_ghosts_part_ways)
+    for f in (
+        history_keys,
+        ghosts_and_plot,
+        replay,
+        replay_refuses_reaching_in,
+        integrator_ghosts_part_ways,
+        ghosts_in_real_time,
+    )
 }
 
 

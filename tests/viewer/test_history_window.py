@@ -18,7 +18,7 @@ DRIVER = Path(__file__).with_name("history_driver.py")
 
 
 # the scenarios of history_driver.py that take no extra arguments, run in one window process
-BATCH = ("history_keys", "ghosts_and_plot")
+BATCH = ("history_keys", "ghosts_and_plot", "ghosts_in_real_time")
 
 
 def run_scenario(display: str, name: str, workdir: Path, *extra: str) -> dict:
@@ -70,6 +70,22 @@ def test_ghosts_show_each_integrators_drift_and_the_plot_draws_it(xvfb, tmp_path
     assert r["ghost_step_after_left"] == 719  # the ghosts step back with the run
     assert r["ghosts_after_left_match"] == {name: True for name in INTEGRATOR_NAMES if name != "rk4"}
     assert "ghosts" not in r["calls_off"]
+
+
+def test_in_real_time_the_ghosts_are_drawn_at_the_step_shown_and_esc_esc_ends_their_process(xvfb, tmp_path):
+    r = run_scenario(xvfb, "ghosts_in_real_time", tmp_path)
+    running = [f for f in r["frames"] if f[0] is not None and f[0] > 0]
+    assert len(running) > 30
+    # two balls, three ghosts each; the child steps ahead of the run, so the frame of the step shown is
+    # there when it is drawn (at most a few frames early on, while the child starts, draw an older one)
+    assert all(f[2] == 3 for f in running)
+    exact = sum(f[1] == f[0] for f in running)
+    assert exact >= 0.8 * len(running)
+    assert all(f[1] <= f[0] for f in running)  # never a step the window does not show yet
+    calls = dict((label, n) for label, n in r["calls"])
+    assert calls["ghosts"] == 6
+    assert r["pid_alive"] and r["closed"] and r["quit_seconds"] < 2.0
+    assert r["pid_gone"]
 
 
 @pytest.fixture

@@ -38,10 +38,12 @@ class EnergyWindow:
 
     def fill(self, time: float, totals: dict[str, float]) -> None:
         """Totals that came later for the sample at simulated ``time`` (the ghosts stepped elsewhere);
-        nothing when no sample is at that time."""
+        nothing when no sample is at that time. A total the sample has already is kept (an edit at
+        that time came after the sample was taken)."""
         for sample in reversed(self.samples):
             if abs(sample[0] - time) <= 1e-9:
-                sample[3].update(totals)
+                for name, total in totals.items():
+                    sample[3].setdefault(name, total)
                 return
             if sample[0] < time:
                 return

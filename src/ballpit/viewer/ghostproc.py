@@ -22,6 +22,7 @@ send, and ``close`` also terminates it, never waiting for it. No GL here.
 
 from __future__ import annotations
 
+import bisect
 import os
 import pickle
 import signal
@@ -41,13 +42,28 @@ AHEAD = 1.0  # s of simulated time the child steps past the main run's latest st
 BATCH = 4  # steps taken between looks at the pipe (one message back for them)
 BODY_BUDGET = 400  # balls × ghosts sent with every step; beyond it, poses every 4 steps
 KEEP_FRAMES = 2048  # frames kept on the main side (about 8 s at 240 steps a second)
+BODY_MEMORY = 64 << 20  # bytes of balls' poses kept at most on the main side (64 a ball per ghost)
 START_TIMEOUT = 120.0  # s a lockstep caller waits at most for the child (its start imports NumPy)
 
 
 def serve(conn: Any) -> None:
-    """The child's loop: build the ghosts, step them ahead, answer moves in time and edits."""
+    """The child's loop: build the ghosts, step them ahead, answer moves in time and edits. A ghost
+    world that fails (a step, an edit) stops the ghosts: the error goes back to be shown."""
+    state: dict[str, Any] = {"epoch": 0}
+    while True:
+        try:
+            _serve(conn, state)
+            return
+        except Exception as exc:  # the ghosts stop; the child waits for the next start
+            try:
+                conn.send(("error", state["epoch"], f"{type(exc).__name__}: {exc}"))
+            except (BrokenPipeError, EOFError, OSError):
+                return
+
+
+def _serve(conn: Any, state: dict[str, Any]) -> None:
     ghosts: Ghosts | None = None
-    epoch, target, ahead, every = 0, 0, 0, 1
+    epoch, target, ahead, every = state["epoch"], 0, 0, 1
     while True:
         idle = ghosts is None or ghosts.current >= target + ahead
         if idle or conn.poll():
@@ -64,7 +80,7 @@ def serve(conn: Any) -> None:
             if kind == "off":
                 ghosts = None
                 continue
-            epoch = message[1]
+            epoch = state["epoch"] = message[1]
             if kind == "start":
                 spec: GhostSpec = message[2]
                 ghosts = Ghosts(spec)
@@ -99,6 +115,37 @@ def _send(conn: Any, epoch: int, frames: list[GhostFrame]) -> bool:
     return True
 
 
+class Frames:
+    """Frames by step, at most ``keep`` of them (the oldest go first), found by bisection."""
+
+    def __init__(self, keep: int) -> None:
+        self.keep = keep
+        self._steps: list[int] = []
+        self._frames: dict[int, GhostFrame] = {}
+
+    def add(self, frame: GhostFrame) -> None:
+        if frame.step not in self._frames:
+            bisect.insort(self._steps, frame.step)
+        self._frames[frame.step] = frame
+        if len(self._steps) > self.keep:
+            del self._frames[self._steps.pop(0)]
+
+    def forget_after(self, step: int | None) -> None:
+        """Forget the frames after ``step`` (all when None)."""
+        cut = 0 if step is None else bisect.bisect_right(self._steps, step)
+        for gone in self._steps[cut:]:
+            del self._frames[gone]
+        del self._steps[cut:]
+
+    def get(self, step: int) -> GhostFrame | None:
+        return self._frames.get(step)
+
+    def at_or_before(self, step: int | None) -> GhostFrame | None:
+        """The frame of the latest step at or before ``step`` (None: the latest of all)."""
+        index = len(self._steps) if step is None else bisect.bisect_right(self._steps, step)
+        return self._frames[self._steps[index - 1]] if index else None
+
+
 class GhostHost:
     """The child process and what it sent back, shared by the ghost runs of one Simulation in turn."""
 
@@ -108,23 +155,25 @@ class GhostHost:
             [sys.executable, "-m", __name__, str(theirs.fileno())], pass_fds=(theirs.fileno(),)
         )
         theirs.close()
+        self.pid = self._process.pid
         self._conn = Connection(ours.detach())
         self._send_lock = threading.Lock()
         self._lock = threading.Condition()
         self._epochs = 0
         self.epoch = 0  # frames of other epochs are ignored
-        self._frames: dict[int, GhostFrame] = {}  # by step, with balls
-        self._totals: dict[int, GhostFrame] = {}  # by step, every frame
+        self._frames = Frames(KEEP_FRAMES)  # with balls
+        self._totals = Frames(KEEP_FRAMES)  # every frame (the energies)
         self._news: deque[GhostFrame] = deque()
         self.received = 0  # frames received (benchmarks and tests read it)
         self.dead = False
+        self.error: str | None = None  # what stopped the child's ghosts, as it said
         self._receiver = threading.Thread(target=self._receive, name="ballpit ghosts in", daemon=True)
         self._receiver.start()
 
     def child_cpu(self) -> float:
         """CPU seconds the child has used (Linux; 0 elsewhere): benchmarks add it to the physics'."""
         try:
-            with open(f"/proc/{self._process.pid}/stat") as f:
+            with open(f"/proc/{self.pid}/stat") as f:
                 fields = f.read().rsplit(")", 1)[1].split()
             return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
         except (OSError, IndexError, ValueError):
@@ -140,14 +189,21 @@ class GhostHost:
             except (BrokenPipeError, EOFError, OSError):
                 self.dead = True
 
+    def start(self, spec: GhostSpec) -> None:
+        """New ghosts from ``spec`` in place of any before (a new epoch, every frame forgotten)."""
+        ball_ghosts = max(len(spec.reference.spheres) * len(spec.integrators), 1)
+        with self._lock:
+            self._frames.keep = int(min(KEEP_FRAMES, max(16, BODY_MEMORY // (64 * ball_ghosts))))
+            self.error = None
+        self.send(("start", self.new_epoch(None), spec))
+
     def new_epoch(self, keep_until: int | None) -> int:
         """Start an epoch: the frames after step ``keep_until`` are forgotten (all when None)."""
         with self._lock:
             self._epochs += 1
             self.epoch = self._epochs
-            for kept in (self._frames, self._totals):
-                for step in [s for s in kept if keep_until is None or s > keep_until]:
-                    del kept[step]
+            self._frames.forget_after(keep_until)
+            self._totals.forget_after(keep_until)
             self._news.clear()
             return self.epoch
 
@@ -155,7 +211,7 @@ class GhostHost:
     def _receive(self) -> None:
         while True:
             try:
-                _, epoch, frames = self._conn.recv()
+                kind, epoch, frames = self._conn.recv()
             except (EOFError, OSError, TypeError, ValueError):
                 with self._lock:
                     self.dead = True
@@ -164,39 +220,36 @@ class GhostHost:
             with self._lock:
                 if epoch != self.epoch:
                     continue
-                for frame in frames:
-                    self._totals[frame.step] = frame
-                    if frame.bodies is not None:
-                        self._frames[frame.step] = frame
-                    self._news.append(frame)
-                    self.received += 1
-                for kept in (self._frames, self._totals):
-                    while len(kept) > KEEP_FRAMES:
-                        del kept[min(kept)]
+                if kind == "error":
+                    self.error = frames
+                else:
+                    for frame in frames:
+                        self._totals.add(frame)
+                        if frame.bodies is not None:
+                            self._frames.add(frame)
+                        self._news.append(frame)
+                    self.received += len(frames)
                 self._lock.notify_all()
 
     def frame_at(self, step: int | None, wait: float = 0.0) -> GhostFrame | None:
-        """See ``GhostRun.frame_at``."""
+        """See ``GhostRun.frame_at``: waiting, until the child has reached ``step`` (any step when None)."""
         deadline = time.perf_counter() + wait
         with self._lock:
             while True:
-                if step is None:
-                    if self._frames or wait <= 0.0:
-                        return self._frames[max(self._frames)] if self._frames else None
-                elif step in self._frames or wait <= 0.0:
-                    earlier = [s for s in self._frames if s <= step]
-                    return self._frames[max(earlier)] if earlier else None
+                reached = self._totals.at_or_before(None) if step is None else self._totals.get(step)
+                if reached is not None or wait <= 0.0:
+                    return self._frames.at_or_before(step)
                 left = deadline - time.perf_counter()
+                if self.error is not None:
+                    raise RuntimeError(f"the ghosts stopped: {self.error}")
                 if self.dead or left <= 0.0:
-                    raise RuntimeError("the ghosts' process did not answer" if not self.dead else
-                                       "the ghosts' process stopped")  # fmt: skip
+                    raise RuntimeError("the ghosts' process stopped" if self.dead else
+                                       "the ghosts' process did not answer")  # fmt: skip
                 self._lock.wait(left)
 
     def totals_at(self, step: int | None) -> dict[str, float] | None:
         with self._lock:
-            if step is None:
-                return self._totals[max(self._totals)].totals if self._totals else None
-            frame = self._totals.get(step)
+            frame = self._totals.at_or_before(None) if step is None else self._totals.get(step)
             return frame.totals if frame is not None else None
 
     def news(self) -> list[GhostFrame]:
@@ -226,7 +279,7 @@ class RemoteGhosts(GhostRun):
         self.target = spec.target  # the main run's latest step, as far as the child was told
         self._told = spec.target
         self._on = True
-        host.send(("start", host.new_epoch(None), spec))
+        host.start(spec)
 
     def stepped(self) -> None:
         """The main run took a live step (the child is told at the next ``flush``)."""
@@ -257,6 +310,10 @@ class RemoteGhosts(GhostRun):
 
     def frame_at(self, step: int | None, wait: float = 0.0) -> GhostFrame | None:
         return self.host.frame_at(step, wait)
+
+    @property
+    def error(self) -> str | None:
+        return self.host.error
 
     def totals_at(self, step: int | None) -> dict[str, float] | None:
         return self.host.totals_at(step)

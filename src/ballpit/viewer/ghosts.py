@@ -93,6 +93,7 @@ class GhostRun:
     """What the viewer knows of the ghosts wherever they are stepped: their spec's facts and the drift."""
 
     remote = False  # stepped in another process: their frames come later than the main run's steps
+    error: str | None = None  # what stopped them (a ghost world failed where they are stepped)
 
     def __init__(self, spec: GhostSpec) -> None:
         self.integrators = spec.integrators

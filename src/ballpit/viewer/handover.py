@@ -204,6 +204,8 @@ def timeline_lines(sim: Simulation) -> list[str]:
         lines.append(f"replay      {timeline.replay.trajectory.path.name}")
     elif span is not None and timeline.history is not None and timeline.history.in_past:
         lines.append(f"history     {span[2] - span[1]:.3f} s in the past; Space resumes")
+    if timeline.ghosts is not None and timeline.ghosts.error is not None:
+        lines.append(f"ghosts stopped: {timeline.ghosts.error}")
     for name, drift, main in timeline.drifts():
         what = "run  " if main else "ghost"
         unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"
