@@ -324,6 +324,10 @@ def ghosts_in_real_time(workdir: Path) -> dict:
         shown = viewer._drawn_shown  # the state the 3-D view was last drawn from
         frames.append([shown.step, shown.ghost_step, len(shown.ghosts)])
     out: dict = {"frames": frames, "calls": [[c.label, c.instances] for c in viewer.renderer.draws.calls]}
+    wd.press(viewer, "SPACE", frames=0)  # paused: a child that fell behind (a loaded machine) catches up
+    wd.pump_until(viewer, lambda: viewer._drawn_shown.ghost_step == viewer._drawn_shown.step, timeout=30)
+    drawn = viewer._drawn_shown
+    out["paused"] = [drawn.step, drawn.ghost_step, viewer.sim.timeline.history.current]
     pid = viewer.sim.ghost_host.pid
     out["pid_alive"] = not _gone(pid)
     viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)

@@ -43,7 +43,10 @@ BATCH = 4  # steps taken between looks at the pipe (one message back for them)
 BODY_BUDGET = 400  # balls × ghosts sent with every step; beyond it, poses every 4 steps
 KEEP_FRAMES = 2048  # frames kept on the main side (about 8 s at 240 steps a second)
 BODY_MEMORY = 64 << 20  # bytes of balls' poses kept at most on the main side (64 a ball per ghost)
-START_TIMEOUT = 120.0  # s a lockstep caller waits at most for the child (its start imports NumPy)
+# The child's niceness: when the window, the main run and the ghosts want more than the cores, the
+# window's frames and the main run's real time come first and the ghosts fall behind (drawn at the
+# latest step they reached) rather than the other way round; with CPU to spare it changes nothing.
+NICE = 5
 
 
 def serve(conn: Any) -> None:
@@ -331,4 +334,5 @@ class RemoteGhosts(GhostRun):
 
 if __name__ == "__main__":
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the viewer's: the child ends with its pipe
+    os.nice(int(os.environ.get("BALLPIT_GHOSTS_NICE", NICE)))
     serve(Connection(int(sys.argv[1])))
