@@ -65,18 +65,18 @@ def test_ghosts_in_their_own_process_follow_the_run_through_steps_back_and_resum
     here, apart = pair()
     try:
         both((here, apart), lambda sim: (sim.toggle_ghosts(), sim.start()))
-        both((here, apart), running(0.5))
-        assert here.timeline.history.current == 120
+        both((here, apart), running(0.3))
+        assert here.timeline.history.current == 72
         assert_same_ghosts(here, apart)
-        both((here, apart), lambda sim: (sim.toggle_pause(), sim.jump(-0.25)))
-        assert here.timeline.history.current == 60
+        both((here, apart), lambda sim: (sim.toggle_pause(), sim.jump(-0.1)))
+        assert here.timeline.history.current == 48
         assert_same_ghosts(here, apart)
         both((here, apart), lambda sim: sim.step_back())
         assert_same_ghosts(here, apart)
-        both((here, apart), lambda sim: sim.scrub(0.8))
+        both((here, apart), lambda sim: sim.scrub(0.5))
         assert_same_ghosts(here, apart)
-        both((here, apart), lambda sim: (sim.toggle_pause(), running(0.3)(sim)))  # resumed from the past
-        assert here.timeline.history.current == 96 + 72
+        both((here, apart), lambda sim: (sim.toggle_pause(), running(0.1)(sim)))  # resumed from the past
+        assert here.timeline.history.current == 36 + 24
         assert_same_ghosts(here, apart)
     finally:
         apart.close()
@@ -85,19 +85,19 @@ def test_ghosts_in_their_own_process_follow_the_run_through_steps_back_and_resum
 def test_edits_resets_and_integrator_switches_reach_the_ghosts_in_the_same_process():
     here, apart = pair()
     try:
-        both((here, apart), lambda sim: (sim.toggle_ghosts(), sim.start(), running(0.25)(sim)))
+        both((here, apart), lambda sim: (sim.toggle_ghosts(), sim.start(), running(0.15)(sim)))
         pid = apart.ghost_host.pid
         # an edit made while the child has stepped ahead of the run: it goes back to the edited step
         time.sleep(0.2)
         both((here, apart), lambda sim: sim.remove_ball(1))
         assert all(len(b[1]) == 2 for b in apart.timeline.ghosts.frame_at(None).bodies)
-        both((here, apart), running(0.25))
+        both((here, apart), running(0.1))
         assert_same_ghosts(here, apart)
         both((here, apart), lambda sim: sim.set_integrator("euler"))
         assert apart.timeline.ghosts.integrators == ("rk2", "rk4", "symplectic")
         both((here, apart), running(0.1))
         assert_same_ghosts(here, apart)
-        both((here, apart), lambda sim: (sim.reset(), sim.start(), running(0.2)(sim)))
+        both((here, apart), lambda sim: (sim.reset(), sim.start(), running(0.1)(sim)))
         assert_same_ghosts(here, apart)
         assert apart.ghost_host.pid == pid  # one child for the viewer's life
         both((here, apart), lambda sim: sim.toggle_ghosts())

@@ -47,6 +47,15 @@ process would share the same cores (and, with the kernel's autogroups, the same 
 thread keeps every World-touching feature (history, ghosts, recording, picking, saving) in one address
 space with plain function calls as commands. The GIL switch interval is lowered while it runs so the
 window, coming back from a GL call, waits at most about a millisecond for the physics to let go.
+
+The integrator ghosts are the exception (``ghosts_apart``, the viewer's default; ghostproc.py): their
+three worlds are stepped in a process of their own. They depend on nothing the main run does after
+their origin but its edits and moves in time, so the child steps them ahead on its own and sends
+back each step's poses and energies; this thread steps the main run alone. With all four worlds here
+the slopes demo with ghosts took 0.51-0.64 CPU s per simulated s, the window was paced at 33 FPS
+(the thread busy) and shown at 24.6 FPS; in paired runs on a loaded machine (load 4-7) the ghosts'
+process had the landing shown at 0.92-1.00 of real time against 0.36-0.58 (docs/benchmarks.md). Lockstep
+(``advance``, ``sync``) waits for the ghosts to reach the main run's step, so tests see them exactly.
 """
 
 from __future__ import annotations
