@@ -90,10 +90,10 @@ def _serve(conn: Any, state: dict[str, Any]) -> None:
                 target = spec.target
                 ahead = round(AHEAD / spec.timestep) if spec.live else 0
                 every = 1 if len(spec.reference.spheres) * len(spec.integrators) <= BODY_BUDGET else 4
-            elif ghosts is not None and kind == "seek":
-                ghosts.seek(message[2])
+            elif ghosts is not None and kind == "seek":  # the main run is at that step now
+                ghosts.seek(target := message[2])
             elif ghosts is not None and kind == "edit":
-                ghosts.edited(message[3], step=message[2])
+                ghosts.edited(message[3], step=(target := message[2]))
             if ghosts is not None:
                 _send(conn, epoch, [ghosts.frame()])
             continue
@@ -249,6 +249,13 @@ class GhostHost:
                     raise RuntimeError("the ghosts' process stopped" if self.dead else
                                        "the ghosts' process did not answer")  # fmt: skip
                 self._lock.wait(left)
+
+    @property
+    def reached(self) -> int | None:
+        """The latest step of the main run the child has sent the ghosts of (this epoch)."""
+        with self._lock:
+            frame = self._totals.at_or_before(None)
+            return frame.step if frame is not None else None
 
     def totals_at(self, step: int | None) -> dict[str, float] | None:
         with self._lock:
