@@ -107,6 +107,9 @@ def set_world(sim: Simulation, name: str, value: object) -> None:
     if name not in AT_ONCE:
         raise ValueError(f"the world has no editable {name!r}")
     setattr(sim.initial, name, value)  # validated here first: a refused value changes neither
+    if name == "integrator":  # as the I key: the ghosts stay the other integrators, not this one
+        sim.set_integrator(str(value))
+        return
     sim.edit(methodcaller("__setattr__", name, value))
 
 
