@@ -16,7 +16,9 @@ Per scene, medians over the runs of:
 - ``fps_after_x``, ``steps_per_second`` and ``real_time_factor`` (the HUD's) over ``--seconds`` from
   one second after the landing;
 - with ``--threads``, the CPU each kind of thread used while the pile landed, in cores: the physics
-  thread, the window's (main) thread, llvmpipe's rasteriser threads and the rest;
+  thread, the integrator ghosts' process (ghostproc.py; ``cpu_ghosts``), the window's (main) thread,
+  llvmpipe's rasteriser threads and the rest; ``physics_cpu_per_sim_s`` counts the physics thread and
+  the ghosts' process;
 - with ``--escape``, Esc, Esc in the middle of a step: from the second key event to the loop's end;
 - with ``--video S``, F9 at X and again once the video holds S seconds (S·30 frames): the landing
   columns then cover the recording, and ``video_frames``, ``video_seconds`` are what ffprobe reads
@@ -27,8 +29,9 @@ Per scene, medians over the runs of:
   ``panel_cpu_ms_*`` the same in the window thread's CPU time (without the waits for the GIL and for a
   core that the wall time holds while the physics thread runs).
   ``--panel off`` opens the viewer with the panel hidden (F4), for a paired comparison of frame rates.
-- ``--ghosts on`` presses G once the window is warm, before X: the three integrator ghosts drop with
-  the main run and are stepped and drawn beside it throughout.
+- ``--ghosts on`` presses G as the window opens (a second before the frames before X are counted): the
+  three integrator ghosts drop with the main run and are stepped and drawn beside it throughout, in a
+  process of their own (``--env BALLPIT_GHOSTS=thread``: on the physics thread, as before, to compare).
 
 ``--env NAME=VALUE`` sets a variable for the child before anything loads (LP_NUM_THREADS, ...); the
 load average of the machine at the start is printed, since the two cores may be shared.
@@ -84,9 +87,8 @@ def thread_cpu():
             out["llvmpipe"] += cpu
         else:
             out["other"] += cpu
-    child = getattr(getattr(viewer, "physics", None), "child_cpu", None)  # a physics process, if any
-    if child is not None:
-        out["physics"] += child()
+    child = getattr(getattr(viewer, "physics", None), "child_cpu", None)  # the ghosts' process, if any
+    out["ghosts"] = child() if child is not None else 0.0
     try:  # the physics thread's time waiting for a core (the rest of its wall time not on one: asleep)
         with open(f"/proc/self/task/{physics}/schedstat") as f:
             out["physics_queued"] = int(f.read().split()[1]) / 1e9
@@ -101,7 +103,7 @@ def hud_factor():
 
 
 out = {}
-state = {"phase": "warm", "at": time.perf_counter() + 1.0}
+state = {"phase": "warm", "at": time.perf_counter() + 1.0, "ghosts": ghosts}
 
 
 def mark():
@@ -120,9 +122,10 @@ def sim_time():
 def tick(_dt):
     now = time.perf_counter()
     phase = state["phase"]
+    if phase == "warm" and state["ghosts"]:  # G first (their process starts meanwhile): they drop with X
+        state["ghosts"] = False
+        viewer.window.dispatch_event("on_key_press", key.G, 0)
     if phase == "warm" and now >= state["at"]:
-        if ghosts:  # G before X: the ghosts drop with the main run
-            viewer.window.dispatch_event("on_key_press", key.G, 0)
         state.update(phase="before", at=now + seconds, mark=mark())
     elif phase == "before" and now >= state["at"]:
         frames, _, t = state["mark"]
@@ -169,7 +172,8 @@ def tick(_dt):
             cpu = thread_cpu()
             for kind, used in cpu.items():
                 out[f"cpu_{kind}"] = (used - state["cpu"][kind]) / wall
-            out["physics_cpu_per_sim_s"] = out["cpu_physics"] * wall / max(simulated, 1e-9)
+            physics = out["cpu_physics"] + out["cpu_ghosts"]
+            out["physics_cpu_per_sim_s"] = physics * wall / max(simulated, 1e-9)
             out["physics_asleep"] = 1.0 - out["cpu_physics"] - out["cpu_physics_queued"]
             out["physics_idle"] = (getattr(viewer.physics, "idle_seconds", 0.0) - state["idle"]) / wall
             captured = getattr(viewer.physics, "capture_seconds", 0.0) - state["captured"]
@@ -222,8 +226,9 @@ COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fp
            "steps_per_second", "real_time_factor", "panel_ms_before", "panel_ms_land"]  # fmt: skip
 COLUMNS += ["panel_cpu_ms_before", "panel_cpu_ms_land"]
 VIDEO_COLUMNS = ["video_frames", "video_seconds", "read_ms", "encode_wait"]
-THREAD_COLUMNS = ["cpu_physics", "cpu_main", "cpu_llvmpipe", "cpu_other", "physics_cpu_per_sim_s",
-                  "cpu_physics_queued", "physics_asleep", "physics_idle", "physics_capture"]  # fmt: skip
+THREAD_COLUMNS = ["cpu_physics", "cpu_ghosts", "cpu_main", "cpu_llvmpipe", "cpu_other",
+                  "physics_cpu_per_sim_s", "cpu_physics_queued", "physics_asleep", "physics_idle",
+                  "physics_capture"]  # fmt: skip
 
 
 def one_run(scene: str, args: argparse.Namespace, size: tuple[int, int], env: dict[str, str],

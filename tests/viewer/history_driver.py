@@ -138,15 +138,18 @@ def ghosts_and_plot(workdir: Path) -> dict:
     steps = sim.timeline.history.current
     out: dict = {"steps": steps, "drifts": sim.timeline.drifts()}
     # the same drift, worked out headless: the run and plain copies under the other integrators
-    expected = {}
+    expected, before_last = {}, {}
     for name in INTEGRATOR_NAMES:
         world = bounce_world()
         e0 = world.kinetic_energy() + world.potential_energy()
         world.integrator = name
-        for _ in range(steps):
+        for step in range(steps):
+            if step == steps - 1:
+                before_last[name] = np.array(world.spheres.positions)
             world.step(DT)
         expected[name] = ((world.kinetic_energy() + world.potential_energy()) - e0) / abs(e0) * 100
     out["expected"] = expected
+    out["ghosts_in_a_process"] = sim.timeline.ghosts.remote and sim.ghost_host.child_cpu() > 0.0
     wd.pump(viewer, 1, dt=0.0)
     out["hud"] = viewer.hud.text
     out["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
@@ -162,10 +165,13 @@ def ghosts_and_plot(workdir: Path) -> dict:
     series = sim.timeline.energy.series()
     out["series"] = sorted(series)
     out["span"] = float(series["time"][-1] - series["time"][0])
-    ghost = sim.timeline.ghosts
-    # stepping back moves the ghosts too
+    # stepping back moves the ghosts too: the window draws them where the same runs were a step earlier
     wd.press(viewer, "LEFT")
-    out["ghost_steps_after_left"] = [g.current for g in ghost.histories.values()]
+    shown = viewer.shown
+    out["ghost_step_after_left"] = shown.ghost_step
+    out["ghosts_after_left_match"] = {
+        name: bool(np.array_equal(positions, before_last[name])) for name, positions, _, _ in shown.ghosts
+    }
     wd.press(viewer, "G")
     wd.pump(viewer, 1, dt=0.0)
     out["calls_off"] = [c.label for c in viewer.renderer.draws.calls]
@@ -284,13 +290,13 @@ def integrator_ghosts_part_ways(workdir: Path) -> dict:
         pixels, depth = viewer.camera.project(main, 640, 360)
         focal = 180 / np.tan(np.radians(viewer.camera.fov_y_degrees / 2))
         at: dict = {"time": float(sim.world.time), "drawn_radius": float(np.median(radius / depth * focal))}
-        for name, ghost in sim.timeline.ghost_worlds():
-            theirs = np.asarray(ghost.spheres.positions)
+        frame = sim.timeline.ghosts.frame_at(sim.timeline.history.current)
+        for name, theirs, _, _ in frame.bodies:
             ghost_pixels, _ = viewer.camera.project(theirs, 640, 360)
             at[name] = {
                 "metres": np.linalg.norm(theirs - main, axis=1).tolist(),
                 "pixels": np.linalg.norm(ghost_pixels - pixels, axis=1).tolist(),
-                "time": float(ghost.time),
+                "time": frame.time,
             }
         wd.pump(viewer, 1, dt=0.0)
         at["calls"] = [[c.label, c.instances] for c in viewer.renderer.draws.calls]
@@ -298,9 +304,70 @@ def integrator_ghosts_part_ways(workdir: Path) -> dict:
     return out
 
 
+def ghosts_in_real_time(workdir: Path) -> dict:
+    """The viewer's own free run (wall-clock frames, the physics running ahead) with the ghosts on: the
+    step each frame draws the ghosts at against the step of the state it shows, then Esc, Esc while the
+    ghosts' process steps ahead: how long the window takes to close, and whether the process is gone."""
+    import time
+
+    from pyglet.window import key
+
+    world = bounce_world()
+    world.add_sphere(position=(1.0, 3.0, 0), radius=0.25, restitution=1.0, friction=0.0)
+    viewer = wd.open_viewer(size=(640, 360), world=world)
+    wd.press(viewer, "G")
+    wd.press(viewer, "X")
+    frames = []
+    end = time.perf_counter() + 3.0
+    while time.perf_counter() < end:
+        viewer.pump()
+        shown = viewer._drawn_shown  # the state the 3-D view was last drawn from
+        frames.append([shown.step, shown.ghost_step, len(shown.ghosts)])
+    out: dict = {"frames": frames, "calls": [[c.label, c.instances] for c in viewer.renderer.draws.calls]}
+    wd.press(viewer, "SPACE", frames=0)  # paused: a child that fell behind (a loaded machine) catches up
+    wd.pump_until(viewer, lambda: viewer._drawn_shown.ghost_step == viewer._drawn_shown.step, timeout=30)
+    drawn = viewer._drawn_shown
+    out["paused"] = [drawn.step, drawn.ghost_step, viewer.sim.timeline.history.current]
+    pid = viewer.sim.ghost_host.pid
+    out["pid_alive"] = not _gone(pid)
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    wd.pump(viewer, 2, dt=None)
+    pressed = time.perf_counter()
+    viewer.window.dispatch_event("on_key_press", key.ESCAPE, 0)
+    while not viewer.closed and time.perf_counter() - pressed < 10:
+        viewer.pump()
+    viewer.pump()
+    out["quit_seconds"] = time.perf_counter() - pressed
+    out["closed"] = viewer.closed
+    deadline = time.perf_counter() + 10
+    while not _gone(pid) and time.perf_counter() < deadline:
+        time.sleep(0.02)
+    out["pid_gone"] = _gone(pid)
+    return out
+
+
+def _gone(pid: int) -> bool:
+    """The process has exited (reaped, or a zombie)."""
+    import os
+
+    try:
+        os.waitpid(pid, os.WNOHANG)  # our child: reap it if it has ended
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
 SCENARIOS = {
     f.__name__: f
-    for f in (history_keys, ghosts_and_plot, replay, replay_refuses_reaching_in, integrator_ghosts_part_ways)
+    for f in (
+        history_keys,
+        ghosts_and_plot,
+        replay,
+        replay_refuses_reaching_in,
+        integrator_ghosts_part_ways,
+        ghosts_in_real_time,
+    )
 }
 
 

@@ -391,9 +391,42 @@ def record_without_pyav(workdir: Path) -> dict:
     return out
 
 
+def busy_panel(workdir: Path) -> dict:
+    """The physics busy (the pacer slow): frames in quick succession draw the panel's last build again,
+    the same pixels; a real pointer move over the panel builds it on the next frame; with the physics
+    at ease again every frame builds it."""
+    from ballpit.viewer import pacing
+
+    viewer = panel_viewer(workdir)
+    backend = viewer.panel.backend
+    width = int(viewer.panel.width)
+    settle(viewer, 6)  # the X events of the pointer placed as it opened are delivered
+    viewer.pacer.slow = True
+    pacing.PANEL_BUSY_HZ = 0.1  # once in ten seconds: what follows is within that, however loaded
+    first = grab(viewer)[:, :width]  # built: the first frame while busy
+    built = backend.builds, backend.redraws
+    same = []
+    for _ in range(4):  # (a stray X event, the window's own, may make one of them build)
+        same.append(bool(np.array_equal(grab(viewer)[:, :width], first)))
+    out: dict = {"quick": [backend.builds - built[0], backend.redraws - built[1]]}
+    out["same_pixels"] = all(same)
+    out["panel_pixels"] = int((first.max(axis=-1) > 0).sum())
+    x, y, w, h = viewer.panel.rects["section Scenes"]
+    builds = backend.builds
+    xdotool("mousemove", "--window", str(viewer.window._window), str(int(x + w / 2)), str(int(y + h / 2)))
+    settle(viewer, 4)
+    out["after_pointer"] = backend.builds - builds
+    viewer.pacer.slow = False
+    builds = backend.builds
+    pump(viewer, 3)
+    out["at_ease"] = backend.builds - builds
+    return out
+
+
 SCENARIOS = {
     f.__name__: f
     for f in (
+        busy_panel,
         scene_list,
         drop_buttons,
         restitution_edit,

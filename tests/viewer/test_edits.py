@@ -137,6 +137,22 @@ def test_a_plane_turned_and_moved_from_the_inspector_and_a_bad_angle_refused():
     assert np.allclose(plane.normal, (-0.5, math.sqrt(3) / 2, 0.0))
 
 
+def test_the_panels_integrator_leaves_the_ghosts_the_other_integrators():
+    sim = Simulation(line_of_balls(3))
+    sim.toggle_ghosts()
+    sim.start()
+    sim.advance(0.1)
+    Edits(run_now(sim)).world("integrator", "rk2")
+    assert sim.world.integrator == "rk2"
+    ghosts = sim.timeline.ghosts
+    assert ghosts.integrators == ("euler", "rk4", "symplectic")
+    assert {name: world.integrator for name, world in ghosts.worlds.items()} == {
+        "euler": "euler",
+        "rk4": "rk4",
+        "symplectic": "symplectic",
+    }
+
+
 def test_deleting_a_ball_shrinks_what_is_kept_per_ball_and_the_ghosts_lose_it_too():
     sim = Simulation(line_of_balls(3))
     sim.toggle_ghosts()

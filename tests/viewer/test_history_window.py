@@ -18,7 +18,7 @@ DRIVER = Path(__file__).with_name("history_driver.py")
 
 
 # the scenarios of history_driver.py that take no extra arguments, run in one window process
-BATCH = ("history_keys", "ghosts_and_plot")
+BATCH = ("history_keys", "ghosts_and_plot", "ghosts_in_real_time")
 
 
 def run_scenario(display: str, name: str, workdir: Path, *extra: str) -> dict:
@@ -66,8 +66,29 @@ def test_ghosts_show_each_integrators_drift_and_the_plot_draws_it(xvfb, tmp_path
     assert r["kinetic_pixels"] > 50
     assert r["series"] == ["kinetic", "potential", "time", *(f"total {n}" for n in sorted(INTEGRATOR_NAMES))]
     assert r["span"] == pytest.approx(3.0, abs=0.05)
-    assert r["ghost_steps_after_left"] == [719] * 3  # the ghosts step back with the run
+    assert r["ghosts_in_a_process"]  # the viewer steps them in a process of their own
+    assert r["ghost_step_after_left"] == 719  # the ghosts step back with the run
+    assert r["ghosts_after_left_match"] == {name: True for name in INTEGRATOR_NAMES if name != "rk4"}
     assert "ghosts" not in r["calls_off"]
+
+
+def test_in_real_time_the_ghosts_are_drawn_at_the_step_shown_and_esc_esc_ends_their_process(xvfb, tmp_path):
+    r = run_scenario(xvfb, "ghosts_in_real_time", tmp_path)
+    running = [f for f in r["frames"] if f[0] is not None and f[0] > 0]
+    assert len(running) > 30
+    # two balls, three ghosts each, in every frame; the child steps ahead of the run, so the frame of
+    # the step shown is there when it is drawn (on a quiet machine every frame; on a loaded one the
+    # child, niced, may fall behind and the latest step it reached is drawn), never a later one
+    assert all(f[2] == 3 for f in running)
+    assert any(f[1] == f[0] for f in running)
+    assert all(f[1] <= f[0] for f in running)
+    assert running[-1][1] > running[0][1]  # they move on
+    step, ghost_step, current = r["paused"]
+    assert step == ghost_step == current  # paused, they are drawn at the step shown
+    calls = dict((label, n) for label, n in r["calls"])
+    assert calls["ghosts"] == 6
+    assert r["pid_alive"] and r["closed"] and r["quit_seconds"] < 2.0
+    assert r["pid_gone"]
 
 
 @pytest.fixture

@@ -10,8 +10,11 @@ from ballpit.viewer.pacing import (
     BUSY_FAST,
     BUSY_SLOW,
     FAST_FPS,
+    HUD_BUSY_INTERVAL,
+    HUD_INTERVAL,
     PACE_FAST,
     PACE_SLOW,
+    PANEL_BUSY_HZ,
     SLOW_FPS,
     FramePacer,
 )
@@ -38,3 +41,16 @@ def test_a_physics_far_behind_real_time_keeps_the_full_rate_since_slower_drawing
 
 def test_the_slow_rate_keeps_the_30_fps_the_viewer_promises():
     assert 30.0 < SLOW_FPS < FAST_FPS and BUSY_FAST < BUSY_SLOW < 1.0 and PACE_FAST < PACE_SLOW
+
+
+def test_while_the_physics_is_busy_the_panel_is_built_ten_times_a_second_and_the_hud_four():
+    pacer = FramePacer()
+    assert pacer.build_panel(0.0) and pacer.build_panel(0.001)  # at ease: every frame
+    assert pacer.hud_interval() == HUD_INTERVAL
+    pacer.interval(1.0)  # busy
+    assert pacer.hud_interval() == HUD_BUSY_INTERVAL == 0.25
+    built = [t for t in (i / 33 for i in range(33)) if pacer.build_panel(10.0 + t)]
+    assert len(built) == PANEL_BUSY_HZ == 10  # a second of 33 frames
+    plain = FramePacer(thrifty=False)
+    plain.interval(1.0)
+    assert plain.build_panel(0.0) and plain.build_panel(0.001) and plain.hud_interval() == HUD_INTERVAL

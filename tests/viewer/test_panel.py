@@ -14,6 +14,7 @@ from .conftest import run_driver
 
 DRIVER = Path(__file__).with_name("panel_driver.py")
 BATCH = (
+    "busy_panel",
     "scene_list",
     "drop_buttons",
     "restitution_edit",
@@ -28,6 +29,15 @@ pytestmark = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
     return run_driver(DRIVER, display, name, workdir, timeout=240, batch=BATCH if name in BATCH else ())
+
+
+def test_while_the_physics_is_busy_frames_draw_the_panels_last_build_again_until_input_comes(xvfb, tmp_path):
+    r = run_scenario(xvfb, "busy_panel", tmp_path)
+    builds, redraws = r["quick"]  # of the next four frames: with no input, no build
+    assert builds + redraws == 4 and redraws >= 2
+    assert r["same_pixels"] and r["panel_pixels"] > 10_000  # and drawn it is, pixel for pixel
+    assert r["after_pointer"] >= 1  # input: built again
+    assert r["at_ease"] == 3
 
 
 def test_clicking_a_scene_in_the_list_loads_it_and_f4_hides_the_panel(xvfb, tmp_path):

@@ -246,14 +246,18 @@ def test_a_record_closed_while_the_run_is_ahead_ends_at_the_state_the_window_sho
         assert run["time"].max() == shown.time
 
 
-def test_the_lead_and_switch_interval_come_from_the_environment_only_where_the_viewer_starts_the_thread():
+def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_thread():
+    """The lead, the switch interval and where the ghosts run."""
     defaults = {"lead": stepper.LEAD_SECONDS, "switch_interval": stepper.SWITCH_INTERVAL}
+    defaults["ghosts_apart"] = True
     assert stepper.tuning_from({}) == defaults
-    tuned = stepper.tuning_from({"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002"})
-    assert tuned == {"lead": 0.0, "switch_interval": 0.002}
+    tuned = stepper.tuning_from({"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002", "BALLPIT_GHOSTS": "thread"})
+    assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False}
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, **tuned)
     try:
         assert physics.lead == 0.0 and not physics._may_run_ahead()  # held to the wall clock
+        sim.toggle_ghosts()
+        assert not sim.timeline.ghosts.remote  # stepped on the physics thread
     finally:
         physics.stop()

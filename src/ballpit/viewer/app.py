@@ -29,7 +29,6 @@ from .pacing import FramePacer
 from .simulation import Phase, Simulation
 
 TITLE_INTERVAL = 0.5  # seconds between FPS title updates
-HUD_INTERVAL = 0.1  # seconds between HUD text updates
 WATCH_INTERVAL = 0.5  # seconds between checks of the scene file's modification time
 
 
@@ -116,7 +115,8 @@ class Viewer:
         self.panel = Panel(self)
         self.panel.shown = panel
         self.view.scene_view(self.shown)
-        self.pacer = FramePacer()  # how often pyglet's loop draws (``run``): fewer while the physics is busy
+        # how often pyglet's loop draws (``run``): fewer while the physics is busy, and cheaper
+        self.pacer = FramePacer(thrifty=os.environ.get("BALLPIT_THRIFT", "1") != "0")
         self._interval: float | None = None  # the redraw interval scheduled now (None: not in the loop)
         self._due: float | None = None  # when the next frame of pyglet's loop is due (``_redraw``)
         self.screen = ScreenOverlay(self.window, self.physics)
@@ -356,6 +356,7 @@ class Viewer:
         self.physics_seconds = time.perf_counter() - started  # lockstep only: free, it is 0
         self.physics.deliver()
         shown = self.physics.shown
+        shown.resolve_ghosts()
 
         self.window.switch_to()
         width, height = self.window.get_framebuffer_size()
@@ -373,7 +374,7 @@ class Viewer:
         view.finish(width, height)
         self._draw_hud(now, shown)
         self.screen.draw_labels()
-        self.panel.draw(shown)
+        self.panel.draw(shown, rebuild=self.pacer.build_panel(now))
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -387,9 +388,9 @@ class Viewer:
         if self.interaction.held_ball is not None:
             return None
         c = self.camera
-        return (id(shown), tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset, width, height,
-                self.flags.contacts, self.flags.velocities, self.flags.trails, self.panel.width,
-                self.interaction.selected_plane, id(self.view_target))  # fmt: skip
+        return (id(shown), shown.ghost_step, tuple(c.position), c.yaw, c.pitch, c.fov_y_degrees, c.inset,
+                width, height, self.flags.contacts, self.flags.velocities, self.flags.trails,
+                self.panel.width, self.interaction.selected_plane, id(self.view_target))  # fmt: skip
 
     def _queue_interaction(self, size: tuple[int, int], seconds: float) -> None:
         """A held ball follows the pointer and a selected plane the held keys: the physics side does it
@@ -425,7 +426,7 @@ class Viewer:
             self.hud.left = self.panel.width
             self.hud.layout()
         if now >= self._hud_at and shown.hud is not None:
-            self._hud_at = now + HUD_INTERVAL
+            self._hud_at = now + self.pacer.hud_interval()
             if self.hud.page == "profile":
                 drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)",
                          f"drawing     {self.pacer.describe()}"]  # fmt: skip

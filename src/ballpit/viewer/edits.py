@@ -13,6 +13,8 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
+from operator import methodcaller
 from pathlib import Path
 from typing import Any
 
@@ -53,12 +55,19 @@ def refusals(command: Callable[[Simulation], Any]) -> Callable[[Simulation], Any
 
 
 # ---------------------------------------------------------------------- the edits (physics side)
+# Each change handed to ``Simulation.edit`` is a ``methodcaller`` or a ``partial`` of a module-level
+# function, not a closure: the ghosts' process gets it pickled (ghostproc.py).
+def set_part(part: str, index: int, name: str, value: object, world: Any) -> None:
+    """``world.<part>[index].<name> = value`` (part: "spheres" or "planes")."""
+    setattr(getattr(world, part)[index], name, value)
+
+
 def set_ball(sim: Simulation, index: int, name: str, value: object) -> None:
     """Ball ``index``'s ``name`` (one of BALL_NUMBERS or BALL_VECTORS) becomes ``value``."""
     if name in ("radius", "mass"):
-        sim.edit(lambda world: world.set_sphere_size(index, **{name: value}))
+        sim.edit(methodcaller("set_sphere_size", index, **{name: value}))
     elif name in BALL_NUMBERS or name in BALL_VECTORS:
-        sim.edit(lambda world: setattr(world.spheres[index], name, value))
+        sim.edit(partial(set_part, "spheres", index, name, value))
     else:
         raise ValueError(f"a ball has no editable {name!r}")
 
@@ -67,9 +76,9 @@ def set_plane(sim: Simulation, index: int, name: str, value: object) -> None:
     """Plane ``index``'s ``name`` (PLANE_NUMBERS or PLANE_VECTORS; rotation in degrees, extrinsic x y z)
     becomes ``value``."""
     if name in ("position", "rotation"):
-        sim.edit(lambda world: world.move_plane(index, **{name: value}))
+        sim.edit(methodcaller("move_plane", index, **{name: value}))
     elif name in PLANE_NUMBERS or name in ("velocity", "angular_velocity"):
-        sim.edit(lambda world: setattr(world.planes[index], name, value))
+        sim.edit(partial(set_part, "planes", index, name, value))
     else:
         raise ValueError(f"a plane has no editable {name!r}")
 
@@ -98,7 +107,10 @@ def set_world(sim: Simulation, name: str, value: object) -> None:
     if name not in AT_ONCE:
         raise ValueError(f"the world has no editable {name!r}")
     setattr(sim.initial, name, value)  # validated here first: a refused value changes neither
-    sim.edit(lambda world: setattr(world, name, value))
+    if name == "integrator":  # as the I key: the ghosts stay the other integrators, not this one
+        sim.set_integrator(str(value))
+        return
+    sim.edit(methodcaller("__setattr__", name, value))
 
 
 def add_ball_at(sim: Simulation, ray: Ray) -> int:

@@ -36,6 +36,18 @@ class EnergyWindow:
         while self.samples and self.samples[0][0] < time - self.window:
             self.samples.popleft()
 
+    def fill(self, time: float, totals: dict[str, float]) -> None:
+        """Totals that came later for the sample at simulated ``time`` (the ghosts stepped elsewhere);
+        nothing when no sample is at that time. A total the sample has already is kept (an edit at
+        that time came after the sample was taken)."""
+        for sample in reversed(self.samples):
+            if abs(sample[0] - time) <= 1e-9:
+                for name, total in totals.items():
+                    sample[3].setdefault(name, total)
+                return
+            if sample[0] < time:
+                return
+
     def series(self) -> dict[str, np.ndarray]:
         """``time``, ``kinetic``, ``potential`` and ``total <integrator>`` arrays (NaN where missing)."""
         if not self.samples:

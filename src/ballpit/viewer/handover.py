@@ -4,7 +4,9 @@ The physics side owns the Simulation and its World; after each batch of steps it
 (ball and plane poses, the overlays asked for, the ghosts, the HUD's facts, the timeline bar, the
 energy trace while the plot is open) and hands it over. The window draws the latest one and never reads
 the World itself, so it never waits for a step and never sees one half done (MuJoCo's ``simulate``
-does the same with its render copy). A Shown is never changed after capture. No GL here.
+does the same with its render copy). A Shown is never changed after capture, but for its ghosts when
+they are stepped in a process of their own: the frame of its step may come after the capture, and the
+window takes it when it shows the state (``resolve_ghosts``). No GL here.
 """
 
 from __future__ import annotations
@@ -104,6 +106,8 @@ class Shown:
     contact_normals: np.ndarray | None = None
     trails: np.ndarray | None = None  # (samples, N, 3), oldest first
     ghosts: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    ghost_step: int | None = None  # the main run's step the ghosts are drawn at
+    ghost_run: Any = None  # ghosts stepped elsewhere (ghostproc.RemoteGhosts), asked again when shown
     hud: HudFacts | None = None
     bar: Bar | None = None
     energy: Any = None  # an EnergyWindow copy while the plot is open
@@ -117,6 +121,16 @@ class Shown:
     @property
     def ball_count(self) -> int:
         return len(self.positions)
+
+    def resolve_ghosts(self) -> None:
+        """The ghosts stepped in their own process: take their frame at this state's step, or the
+        nearest earlier one, if it came after the capture (the window calls it before drawing)."""
+        run = self.ghost_run
+        if run is None or self.step is None or self.ghost_step == self.step:
+            return
+        frame = run.frame_at(self.step)
+        if frame is not None and frame.step != self.ghost_step:
+            self.ghosts, self.ghost_step = list(frame.bodies), frame.step
 
 
 def capture(sim: Simulation, needs: Needs = Needs(), hud: HudFacts | None = None) -> Shown:
@@ -151,9 +165,13 @@ def capture(sim: Simulation, needs: Needs = Needs(), hud: HudFacts | None = None
     if needs.trails and sim.trails.filled:
         shown.trails = sim.trails.ordered()  # fancy indexing: a copy
     timeline = sim.timeline
-    for name, ghost in timeline.ghost_worlds():
-        g = ghost.spheres
-        shown.ghosts.append((name, np.array(g.positions), np.array(g.orientations), np.array(g.radii)))
+    ghosts = timeline.ghosts
+    if ghosts is not None:
+        frame = ghosts.frame_at(shown.step)
+        if frame is not None:
+            shown.ghosts, shown.ghost_step = list(frame.bodies), frame.step
+        if ghosts.remote:
+            shown.ghost_run = ghosts
     source = timeline.source
     if source is not None:
         oldest, now, newest = timeline.span()
@@ -186,6 +204,8 @@ def timeline_lines(sim: Simulation) -> list[str]:
         lines.append(f"replay      {timeline.replay.trajectory.path.name}")
     elif span is not None and timeline.history is not None and timeline.history.in_past:
         lines.append(f"history     {span[2] - span[1]:.3f} s in the past; Space resumes")
+    if timeline.ghosts is not None and timeline.ghosts.error is not None:
+        lines.append(f"ghosts stopped: {timeline.ghosts.error}")
     for name, drift, main in timeline.drifts():
         what = "run  " if main else "ghost"
         unit = "%" if timeline.ghosts is not None and timeline.ghosts.reference_energy != 0.0 else "J"

@@ -11,6 +11,12 @@ the CPU given back could not bring it near; and it goes back up once the physics
 Each pair of thresholds is apart so the rate does not flip every time they are measured. A GPU draws
 a frame in a fraction of a millisecond of CPU; there the physics rarely needs the slower rate.
 
+While the physics is busy the frames drawn cost less too: the panel is built with ImGui at most
+``PANEL_BUSY_HZ`` times a second (in between its last build is drawn again, unless input came) and the
+HUD's text laid out again every ``HUD_BUSY_INTERVAL`` (pyglet lays the whole text out again whenever
+it changes: a few ms of the window's thread). Both are work of the window's thread between frames
+that the physics does not get; the frames themselves are as many as before.
+
 No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share and pace.
 """
 
@@ -28,6 +34,9 @@ BUSY_FAST = 0.7  # at most this share: the full rate again
 # anyway, where the frames are worth more. Apart for the same reason as the busy thresholds.
 PACE_SLOW = 0.25
 PACE_FAST = 0.2
+HUD_INTERVAL = 0.1  # s between HUD text updates
+HUD_BUSY_INTERVAL = 0.25  # while the physics needs the CPU
+PANEL_BUSY_HZ = 10.0  # panel builds a second at most while the physics needs the CPU
 
 
 @dataclass
@@ -35,6 +44,8 @@ class FramePacer:
     """Chooses the time between frames from the physics thread's busy share and pace."""
 
     slow: bool = False
+    thrifty: bool = True  # while slow, the panel and the HUD's text are built less often
+    _panel_at: float = 0.0
 
     def interval(self, busy: float, pace: float = 1.0) -> float:
         """Seconds between frames, given the share of the latest stretch the physics spent stepping
@@ -45,6 +56,19 @@ class FramePacer:
         elif busy <= BUSY_FAST or pace < PACE_FAST:
             self.slow = False
         return 1.0 / (SLOW_FPS if self.slow else FAST_FPS)
+
+    def hud_interval(self) -> float:
+        """Seconds until the HUD's text is laid out again."""
+        return HUD_BUSY_INTERVAL if self.slow and self.thrifty else HUD_INTERVAL
+
+    def build_panel(self, now: float) -> bool:
+        """Whether the panel is built this frame (else its last build is drawn again)."""
+        step = 1.0 / PANEL_BUSY_HZ
+        if not (self.slow and self.thrifty) or now >= self._panel_at:
+            late = now - self._panel_at
+            self._panel_at = (self._panel_at if late < step else now) + step  # from when it was due
+            return True
+        return False
 
     def describe(self) -> str:
         """For the profile page: the rate chosen and why."""

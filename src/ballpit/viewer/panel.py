@@ -142,8 +142,14 @@ class Panel:
         return 1e3 * float(np.mean(kept)) if kept else 0.0
 
     # ------------------------------------------------------------------ the frame
-    def draw(self, shown: Shown) -> None:
+    def draw(self, shown: Shown, rebuild: bool = True) -> None:
+        """Build the panel for ``shown`` and draw it; without ``rebuild``, draw its last build again
+        when no input came since (the window's frames while the physics is busy: pacing.py)."""
         started, cpu = time.perf_counter(), time.thread_time()
+        if not rebuild and self.backend.redraw():
+            self.seconds.append(time.perf_counter() - started)
+            self.cpu_seconds.append(time.thread_time() - cpu)
+            return
         self.backend.new_frame()
         watch: Watch | None = shown.watch
         if self.shown and watch is not None:

@@ -104,6 +104,9 @@ class PanelBackend:
         self.renderer._window = window
         self._last = time.perf_counter()
         self._pointer: tuple[float, float] | None = None
+        self.fed = True  # input came since the last build: the next frame builds the panel again
+        self._built = False
+        self.builds = self.redraws = 0  # frames that built the panel, and that drew the last build again
 
     def activate(self) -> None:
         """Make this panel's ImGui and ImPlot contexts current (each window has its own)."""
@@ -112,29 +115,35 @@ class PanelBackend:
 
     # ------------------------------------------------------------------ events (window coordinates, y up)
     def mouse_motion(self, x: float, y: float) -> None:
+        self.fed = True
         self.activate()
         self.renderer.on_mouse_motion(x, y, 0, 0)
         self._pointer = (x, y)
 
     def mouse_button(self, x: float, y: float, button: int, down: bool) -> None:
+        self.fed = True
         self.activate()
         self.mouse_motion(x, y)
         self.renderer._on_mouse_button(button, down)
 
     def scroll(self, x: float, y: float, scroll_x: float, scroll_y: float) -> None:
+        self.fed = True
         self.activate()
         self.mouse_motion(x, y)
         self.renderer.on_mouse_scroll(x, y, scroll_x, scroll_y)
 
     def key(self, symbol: int, down: bool) -> None:
+        self.fed = True
         self.activate()
         self.renderer._on_key(symbol, down)
 
     def text(self, text: str) -> None:
+        self.fed = True
         self.activate()
         self.renderer.on_text(text)
 
     def resize(self) -> None:
+        self.fed = True
         self.activate()
         self.renderer.on_resize(0, 0)
 
@@ -160,10 +169,25 @@ class PanelBackend:
         self._last = now
         self.renderer._set_pixel_ratio(self.window)
         imgui.new_frame()
+        self.fed = False
+        self.builds += 1
 
     def render(self) -> None:
         imgui.render()
+        self._built = True
         self.renderer.render(imgui.get_draw_data())
+
+    def redraw(self) -> bool:
+        """Draw the last built frame again (ImGui keeps its draw data until the next ``new_frame``);
+        False, drawing nothing, when input came since or there is no frame to draw (or the clip
+        rectangles would be scaled again: a framebuffer scale other than 1)."""
+        self.activate()
+        scale = tuple(imgui.get_io().display_framebuffer_scale)
+        if self.fed or not self._built or scale != (1.0, 1.0):
+            return False
+        self.renderer.render(imgui.get_draw_data())
+        self.redraws += 1
+        return True
 
     def shutdown(self) -> None:
         """Free the GL objects (with the window's context current) and the contexts."""

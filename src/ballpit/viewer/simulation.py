@@ -18,7 +18,9 @@ import sys
 import time
 from collections.abc import Callable
 from enum import Enum
+from operator import methodcaller
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -116,6 +118,8 @@ class Simulation:
         self.after_step: list[Callable[[], None]] = []
         self.after_reset: list[Callable[[], None]] = []
         self.after_resume_from_past: list[Callable[[int], None]] = []  # gets the step resumed from
+        self.ghost_host: Any = None  # ghostproc.GhostHost: the ghosts stepped in a process of their own
+        self._ghosts_apart = False
         self._install(scene_of(world, path))
 
     # ------------------------------------------------------------------ world management
@@ -169,14 +173,39 @@ class Simulation:
             look.sphere_colors = np.vstack(
                 [look.sphere_colors, palette_colors(trajectory.balls - first, first)]
             )
+        if getattr(self, "timeline", None) is not None:
+            self.timeline.close()
         self.timeline = Timeline(
-            self.world, self.timestep, trajectory, on_seek=self.after_seek, on_replay_end=self.end_of_replay
+            self.world,
+            self.timestep,
+            trajectory,
+            on_seek=self.after_seek,
+            on_replay_end=self.end_of_replay,
+            host=self._host if self._ghosts_apart else None,
         )
         if trajectory is not None:
             self.after_seek(None)  # frame 0 of the replay is in the world now
         if ghosts:
             self.timeline.toggle_ghosts()
         self.timeline.sample_energy()
+
+    def ghosts_apart(self) -> None:
+        """Step the integrator ghosts in a process of their own from the next time they start
+        (ghostproc.py; the process starts then): the viewer's physics thread steps the main run alone."""
+        self._ghosts_apart = True
+        self.timeline.host = self._host
+
+    def _host(self) -> Any:
+        if self.ghost_host is None:
+            from .ghostproc import GhostHost
+
+            self.ghost_host = GhostHost()
+        return self.ghost_host
+
+    def close(self) -> None:
+        """Stop the ghosts' process, if any (never waits for it)."""
+        if self.ghost_host is not None:
+            self.ghost_host.close()
 
     @property
     def timestep(self) -> float:
@@ -361,10 +390,11 @@ class Simulation:
 
     def edit(self, change: Callable[[object], object], ghosts: bool = True) -> object:
         """A change by hand between steps: ``change(world)`` (a World method that refuses bad values
-        with ValueError/TypeError and then changes nothing). The history keeps the changed state as the
-        present (re-stepping starts from it; any later steps are dropped) and, with ``ghosts``, each
-        ghost gets the same change, so an edited run is recorded and compared as what it is. A replay
-        refuses (ValueError): it writes the recorded frames into the world."""
+        with ValueError/TypeError and then changes nothing; with ``ghosts``, picklable: a methodcaller
+        or a partial, sent to the ghosts' process when they run in one). The history keeps the changed
+        state as the present (re-stepping starts from it; any later steps are dropped) and, with
+        ``ghosts``, each ghost gets the same change, so an edited run is recorded and compared as what
+        it is. A replay refuses (ValueError): it writes the recorded frames into the world."""
         if self.timeline.replay is not None:
             raise ValueError("a replay plays a recorded run: it cannot be edited")
         result = change(self.world)
@@ -373,7 +403,7 @@ class Simulation:
 
     def remove_ball(self, index: int) -> None:
         """Remove ball ``index`` (it and the ghosts' copies); what is kept per ball shrinks with it."""
-        self.edit(lambda world: world.remove_sphere(index))
+        self.edit(methodcaller("remove_sphere", index))
         look = self.appearance
         look.sphere_colors = np.delete(look.sphere_colors, index, axis=0)
         self.prev_positions = np.delete(self.prev_positions, index, axis=0)
@@ -404,7 +434,7 @@ class Simulation:
     def add_ball(self, color: object, **kwargs: object) -> int:
         """Add a ball to the live world (``World.add_sphere`` arguments) drawn in ``color``; returns its
         index. Everything kept per ball (colours, trails, interpolation) grows with it."""
-        ball = self.edit(lambda world: world.add_sphere(**kwargs))
+        ball = self.edit(methodcaller("add_sphere", **kwargs))
         look = self.appearance
         look.sphere_colors = np.vstack([look.sphere_colors, np.asarray(color, dtype=float).reshape(1, 3)])
         self.prev_positions = np.vstack([self.prev_positions, ball.position])

@@ -47,6 +47,15 @@ process would share the same cores (and, with the kernel's autogroups, the same 
 thread keeps every World-touching feature (history, ghosts, recording, picking, saving) in one address
 space with plain function calls as commands. The GIL switch interval is lowered while it runs so the
 window, coming back from a GL call, waits at most about a millisecond for the physics to let go.
+
+The integrator ghosts are the exception (``ghosts_apart``, the viewer's default; ghostproc.py): their
+three worlds are stepped in a process of their own. They depend on nothing the main run does after
+their origin but its edits and moves in time, so the child steps them ahead on its own and sends
+back each step's poses and energies; this thread steps the main run alone. With all four worlds here
+the slopes demo with ghosts took 0.51-0.64 CPU s per simulated s, the window was paced at 33 FPS
+(the thread busy) and shown at 24.6 FPS; in paired runs on a loaded machine (load 4-7) the ghosts'
+process had the landing shown at 0.92-1.00 of real time against 0.36-0.58 (docs/benchmarks.md). Lockstep
+(``advance``, ``sync``) waits for the ghosts to reach the main run's step, so tests see them exactly.
 """
 
 from __future__ import annotations
@@ -73,15 +82,18 @@ LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = 0.001
+GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach the main run's step
 
 
-def tuning_from(environ: Mapping[str, str]) -> dict[str, float]:
+def tuning_from(environ: Mapping[str, str]) -> dict[str, Any]:
     """The thread's tuning as a benchmark sets it in the environment (read by the viewer when it starts
-    the thread, and passed in): ``BALLPIT_LEAD`` (s; 0 holds the physics to the wall clock) and
-    ``BALLPIT_SWITCH`` (s), each LEAD_SECONDS and SWITCH_INTERVAL when not set."""
+    the thread, and passed in): ``BALLPIT_LEAD`` (s; 0 holds the physics to the wall clock),
+    ``BALLPIT_SWITCH`` (s), each LEAD_SECONDS and SWITCH_INTERVAL when not set, and ``BALLPIT_GHOSTS``
+    (``process``, the default, or ``thread``: the integrator ghosts stepped on this thread)."""
     return {
         "lead": float(environ.get("BALLPIT_LEAD", LEAD_SECONDS)),
         "switch_interval": float(environ.get("BALLPIT_SWITCH", SWITCH_INTERVAL)),
+        "ghosts_apart": environ.get("BALLPIT_GHOSTS", "process") != "thread",
     }
 
 
@@ -99,8 +111,11 @@ class PhysicsThread:
         watch: Callable[[Simulation], Any] | None = None,
         lead: float = LEAD_SECONDS,
         switch_interval: float = SWITCH_INTERVAL,
+        ghosts_apart: bool = False,
     ) -> None:
         self.sim = sim
+        if ghosts_apart:  # the integrator ghosts' worlds in a process of their own (ghostproc.py)
+            sim.ghosts_apart()
         self.lead = lead  # s of wall time the run may be stepped ahead of what the window shows
         self.needs = needs  # what the window draws now (asked at each capture)
         self.watch = watch  # the panel's copy of the run, made at each capture (Shown.watch)
@@ -175,6 +190,7 @@ class PhysicsThread:
             self._rewind_to_shown()
             self._apply_commands()
             steps = self.sim.advance(seconds)
+            self.sim.timeline.settle_ghosts(GHOST_WAIT)
             self._publish(force_hud=False)
         self.deliver()
         return steps
@@ -183,6 +199,7 @@ class PhysicsThread:
         """Apply the pending commands now, waiting for a step in progress (tests and scripted runs)."""
         with self.lock:
             self._apply_commands()
+            self.sim.timeline.settle_ghosts(GHOST_WAIT)
             self._publish(force_hud=True)
         self.deliver()
 
@@ -203,12 +220,18 @@ class PhysicsThread:
         self._free = False
         self._wake.set()
         sys.setswitchinterval(self._previous_switch)
+        self.sim.close()  # the ghosts' process, if any: terminated, not waited for
 
     @property
     def pace(self) -> float:
         """The share of the asked speed the physics reached lately: real-time factor over time scale."""
         sim = self.sim
         return sim.real_time_factor / max(sim.time_scale, 1e-9)
+
+    def child_cpu(self) -> float:
+        """CPU seconds used by the ghosts' process, if any (benchmarks add it to the physics')."""
+        host = self.sim.ghost_host
+        return host.child_cpu() if host is not None else 0.0
 
     @property
     def alive(self) -> bool:
@@ -244,7 +267,8 @@ class PhysicsThread:
                         self._base = None
                         steps = self.sim.advance(now - last)
                         last = now
-                        if steps or commands or now - published >= IDLE_HANDOVER:  # else as before:
+                        news = self.sim.timeline.take_ghost_news()  # a seek's ghosts came, say
+                        if steps or commands or news or now - published >= IDLE_HANDOVER:  # else as before:
                             self._publish(force_hud=False)  # the window may keep the view it drew
                             published = now
                 except Exception as exc:  # never let the thread die silently: say why in the HUD

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..cli.trajectory import Trajectory
 from .energyplot import EnergyWindow
-from .ghosts import CATCH_UP_STEPS, Ghosts, total_energy
+from .ghosts import CATCH_UP_STEPS, Body, GhostRun, Ghosts, GhostSpec
 from .history import History
 from .replay import Replay
 
@@ -28,7 +28,8 @@ class Timeline:
     """History (live runs) or Replay (trajectories), ghosts and the energy trace of one world.
 
     ``on_seek(contacts)`` is called after every move in time (with the contacts of the step reached,
-    when the source kept them), ``on_replay_end()`` when a replay has shown its last frame.
+    when the source kept them), ``on_replay_end()`` when a replay has shown its last frame. With
+    ``host`` (giving a ghostproc.GhostHost) the ghosts are stepped in its process, else here.
     """
 
     def __init__(
@@ -39,13 +40,15 @@ class Timeline:
         *,
         on_seek: Callable[[Any], None],
         on_replay_end: Callable[[], None],
+        host: Callable[[], Any] | None = None,
     ) -> None:
         self.world = world
         self.timestep = timestep
         self._on_seek, self._on_replay_end = on_seek, on_replay_end
         self.history: History | None = None
         self.replay: Replay | None = Replay(world, trajectory) if trajectory is not None else None
-        self.ghosts: Ghosts | None = None
+        self.host = host
+        self.ghosts: GhostRun | None = None
         self.energy = EnergyWindow()
         self._origin: Any = None  # the drop's snapshot, for ghosts started later
 
@@ -74,7 +77,7 @@ class Timeline:
             self.history = History(self.world, self.timestep)
             self._origin = self.world.snapshot()
             if self.ghosts is not None:  # G before X: the ghosts start with the drop
-                self.ghosts = Ghosts(self.world, self._origin, 0, self.history)
+                self._start_ghosts(self._origin, 0)
 
     def step(self, dt: float) -> Any:
         """One fixed step: the physics (recorded, ghosts alongside) or the next replay frame."""
@@ -107,7 +110,7 @@ class Timeline:
         if self.history is not None:
             self.history.changed()
         if self.ghosts is not None and change is not None:
-            self.ghosts.edited(change)
+            self.ghosts.edited(change, self.history.current if self.history is not None else None)
 
     # ------------------------------------------------------------------ moving in time
     def seek(self, step: int) -> bool:
@@ -147,36 +150,80 @@ class Timeline:
     def toggle_ghosts(self) -> str:
         """G: start or stop the ghosts; returns the message for the HUD."""
         if self.ghosts is not None:
-            self.ghosts = None
+            self.close()
             return "ghosts off"
         if self.replay is not None:
             return "ghosts need a live run, not a replay"
         world = self.world
         h = self.history
         if h is None:  # before the drop: they start with it
-            self.ghosts = Ghosts(world, world.snapshot(), 0, None)
+            self._start_ghosts(world.snapshot(), 0)
             return "ghosts on: they drop with X"
         if h.current <= CATCH_UP_STEPS and h.first == 0:
-            self.ghosts = Ghosts(world, self._origin, 0, h)
+            self._start_ghosts(self._origin, 0)
             return "ghosts on: energy drift since the drop"
-        self.ghosts = Ghosts(world, world.snapshot(), h.current, h)
+        self._start_ghosts(world.snapshot(), h.current)
         return f"ghosts on: energy drift since t = {world.time:.2f} s"
 
-    def drifts(self) -> list[tuple[str, float, bool]]:
-        return self.ghosts.drifts(self.world) if self.ghosts is not None else []
+    def _start_ghosts(self, origin: Any, origin_step: int) -> None:
+        """Ghosts from ``origin`` (a snapshot of the world at ``origin_step``), caught up to the present."""
+        self.close()
+        spec = GhostSpec.of(self.world, origin, origin_step, self.history)
+        if self.host is not None:
+            from .ghostproc import RemoteGhosts
 
-    def ghost_worlds(self) -> list[tuple[str, Any]]:
-        return list(self.ghosts.worlds.items()) if self.ghosts is not None else []
+            self.ghosts = RemoteGhosts(self.host(), spec)
+        else:
+            self.ghosts = Ghosts(spec)
+
+    def close(self) -> None:
+        """The ghosts off (their process, if any, lets their worlds go)."""
+        if self.ghosts is not None:
+            self.ghosts.close()
+            self.ghosts = None
+
+    @property
+    def _step(self) -> int | None:
+        """The main run's step in its history (None before the drop)."""
+        return self.history.current if self.history is not None else None
+
+    def drifts(self) -> list[tuple[str, float, bool]]:
+        return self.ghosts.drifts(self.world, self._step) if self.ghosts is not None else []
+
+    def ghost_bodies(self) -> tuple[Body, ...]:
+        """Each ghost's balls at the main run's step (or the nearest earlier one received)."""
+        frame = self.ghosts.frame_at(self._step) if self.ghosts is not None else None
+        return frame.bodies if frame is not None else ()
+
+    def settle_ghosts(self, wait: float) -> None:
+        """Lockstep: wait up to ``wait`` seconds for the ghosts to reach the main run's step, and put
+        their energies in the trace (RuntimeError when their process does not answer)."""
+        if self.ghosts is not None:
+            self.ghosts.flush()
+            self.ghosts.frame_at(self._step, wait=wait)
+            self.take_ghost_news()
+
+    def take_ghost_news(self) -> bool:
+        """Put the ghosts' energies received since the last call in the energy trace; true when any
+        came (what the window shows of the ghosts may have changed)."""
+        news = self.ghosts.news() if self.ghosts is not None else []
+        for frame in news:
+            self.energy.fill(frame.time, frame.totals)
+        return bool(news)
 
     # ------------------------------------------------------------------ energy
     def sample_energy(self) -> None:
-        """One sample of the energy trace at the world's time (once per frame)."""
+        """One sample of the energy trace at the world's time (once per frame); the ghosts' totals at
+        the same step join it now or when they come."""
         world = self.world
         kinetic, potential = world.kinetic_energy(), world.potential_energy()
         totals = {world.integrator: kinetic + potential}
-        for name, ghost in self.ghost_worlds():
-            totals[name] = total_energy(ghost)
+        ghosts = self.ghosts
+        if ghosts is not None:
+            ghosts.flush()
+            totals |= ghosts.totals_at(self._step) or {}
         self.energy.add(world.time, kinetic, potential, totals)
+        self.take_ghost_news()
 
 
 def _no_contacts() -> Any:
