@@ -3,6 +3,7 @@ one ball twice."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -88,3 +89,24 @@ def test_every_pair_of_colours_is_disjoint():
     colours = rows.colour(a, b, 5)
     for x, y in itertools.combinations(colours, 2):
         assert not set(x.tolist()) & set(y.tolist())
+
+
+def test_rows_that_let_go_of_their_radii_keep_each_contacts_lever_arms_in_subsets_and_copies():
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane()
+    radii = (0.2, 0.3, 0.5)
+    world.add_spheres([(0, 0.2, 0), (0.5, 0.3, 0), (1.3, 0.5, 0)], radius=list(radii))
+    _, r = built(world)
+    r.forget_radii()
+    assert r.radius_a is None and r.radius_b is None
+    pairs = r.b != 3  # ball against ball: both arms are the balls' radii; on the plane, b's arm is 0
+    sub = r.subset(pairs)
+    copy = dataclasses.replace(sub, friction=np.zeros(len(sub)))
+    expected_a = [radii[a] for a in sub.a]
+    expected_b = [radii[b] for b in sub.b]
+    for rows_ in (sub, copy):
+        arm_a, arm_b = rows_.arm_lengths()
+        assert arm_a == pytest.approx(expected_a, rel=1e-15) and arm_b == pytest.approx(expected_b, rel=1e-15)
+    plane = r.subset(~pairs)
+    assert plane.arm_lengths()[1].tolist() == [0.0] * 3
+    assert plane.arm_lengths()[0] == pytest.approx([radii[a] for a in plane.a], rel=1e-15)
