@@ -3,7 +3,9 @@ conftest.py) is a ``window`` test without saying so; ``slow`` ones say so themse
 
 Under pytest-xdist (``make test``: ``-n auto --dist loadgroup``) the tests of a module that runs its
 window scenarios as one batch (a module-level ``BATCH``: tests/viewer/conftest.py's ``run_driver``)
-share one worker, so the batch runs once, not once on every worker its tests land on."""
+share one worker, so the batch runs once, not once on every worker its tests land on. So do the tests
+of a module that use one of the costly module-scoped fixtures it names in ``SHARED`` (a scene run, a
+pile settled first), so the fixture is made once."""
 
 from __future__ import annotations
 
@@ -26,5 +28,6 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         if WINDOW_FIXTURES.intersection(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.window)
         module = getattr(item, "module", None)
-        if getattr(module, "BATCH", None):
+        shared = set(getattr(module, "SHARED", ())).intersection(getattr(item, "fixturenames", ()))
+        if getattr(module, "BATCH", None) or shared:
             item.add_marker(pytest.mark.xdist_group(module.__name__))

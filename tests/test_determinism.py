@@ -27,6 +27,7 @@ from pathlib import Path
 
 import pytest
 
+SHARED = ("runs",)  # the default run and one per switch, made once (tests/conftest.py: on one worker)
 pytestmark = pytest.mark.slow  # subprocesses under other CPU kernels: `make test`, not `make check`
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"

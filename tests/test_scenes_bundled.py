@@ -21,6 +21,7 @@ from ballpit.viewer.camera import Camera
 
 from .cli.runner import run_in_process
 
+SHARED = ("slopes_run",)  # 10 s of the slopes through the CLI, made once (tests/conftest.py: on one worker)
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
 REQUIRED = {

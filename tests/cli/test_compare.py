@@ -27,6 +27,7 @@ from .bouncing_box import (
 )
 from .runner import run_in_process
 
+SHARED = ("cli_run",)  # one real compare run, made once (tests/conftest.py: on one worker)
 ROOT = Path(__file__).resolve().parents[2]
 FLIGHTS = 3
 DURATION = 3.03  # s: a whole number of steps, just past 3 flights of the exact motion (3.029 s)

@@ -20,6 +20,7 @@ from ballpit.scene import read_scene
 
 from .runner import run_in_process
 
+SHARED = ("slopes_reference",)  # the reference run, made once (tests/conftest.py: on one worker)
 ROOT = Path(__file__).resolve().parents[2]
 SLOPES = ROOT / "scenes" / "slopes.toml"
 TRAJECTORY = "time,id,x,y,z,vx,vy,vz,wx,wy,wz,qx,qy,qz,qw".split(",")

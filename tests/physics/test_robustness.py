@@ -11,6 +11,7 @@ import pytest
 import ballpit
 from ballpit.scene import read_scene
 
+SHARED = ("sleeping_pile",)  # a 200-ball pile settled asleep, made once (tests/conftest.py: one worker)
 BOX = 2.0  # m, a closed cube from (−1, 0, −1) to (1, 2, 1)
 
 

@@ -10,10 +10,11 @@ from .conftest import run_driver
 from .rough_edges_driver import SCENARIOS
 
 DRIVER = Path(__file__).with_name("rough_edges_driver.py")
+BATCH = tuple(SCENARIOS)  # every scenario runs in one window process, on one worker
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    return run_driver(DRIVER, display, name, workdir, timeout=120, batch=tuple(SCENARIOS))
+    return run_driver(DRIVER, display, name, workdir, timeout=120, batch=BATCH)
 
 
 def test_a_slope_tilted_over_by_the_arrow_keys_shows_its_colour_on_its_back(xvfb, tmp_path):

@@ -17,10 +17,11 @@ from .conftest import REPO, run_driver, subprocess_env
 from .window_driver import GOOD_SCENE, SCENARIOS
 
 DRIVER = Path(__file__).with_name("window_driver.py")
+BATCH = tuple(SCENARIOS)  # every scenario runs in one window process, on one worker
 
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
-    return run_driver(DRIVER, display, name, workdir, timeout=120, batch=tuple(SCENARIOS))
+    return run_driver(DRIVER, display, name, workdir, timeout=120, batch=BATCH)
 
 
 def test_the_title_shows_the_frame_rate(xvfb, tmp_path):

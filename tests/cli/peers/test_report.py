@@ -15,6 +15,7 @@ from ballpit.cli.peers.measure import Landed
 
 from .test_engines import ALL, BOUNCE_TOLERANCE
 
+SHARED = ("small_grid",)  # a real run of every installed engine, made once (tests/conftest.py: on one worker)
 RATES = {"ballpit": [300.0, 100.0, 200.0], "mujoco": [50.0, 40.0, 60.0], "pybullet": [20.0, 25.0, 30.0]}
 
 

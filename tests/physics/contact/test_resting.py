@@ -43,7 +43,10 @@ def test_a_few_hundred_balls_settle_into_a_still_pile():
 
 
 @pytest.mark.slow
-def test_elastic_gas_in_a_closed_box_keeps_its_energy_for_a_minute():
+def test_elastic_gas_in_a_closed_box_keeps_its_energy_through_thousands_of_collisions():
+    """64 elastic, frictionless balls in a closed box without gravity: 15 s and more than 3,000
+    collisions later the kinetic energy is the same to 1e-9 (a resting solve that did work on
+    separating or sliding contacts would drain or feed it far beyond that)."""
     rng = np.random.default_rng(5)
     world = ballpit.World(gravity=(0, 0, 0))
     half = 1.0
@@ -54,10 +57,10 @@ def test_elastic_gas_in_a_closed_box_keeps_its_energy_for_a_minute():
     world.add_spheres(positions, radius=0.1, velocity=rng.normal(0, 1.5, (len(grid), 3)), friction=0.0)
     energy = world.kinetic_energy()
     hits = 0
-    for _ in range(60 * 60):
+    for _ in range(15 * 60):
         hits += len(world.step(1 / 60))
-    assert hits > 1000
-    assert world.kinetic_energy() == pytest.approx(energy, rel=0.01)
+    assert hits > 3000
+    assert world.kinetic_energy() == pytest.approx(energy, rel=1e-9)
     x = world.spheres.positions
     assert np.abs(x[:, [0, 2]]).max() <= half - 0.1 + 1e-6
 
