@@ -212,7 +212,7 @@ def test_the_bundled_pile_lands_with_overlaps_under_a_tenth_of_a_radius_and_rest
         world.step(dt)
         balls, walls = deepest_overlaps(world)
         landing = max(landing, balls, walls)
-        if world.time >= 2.8:
+        if world.time >= 2.0 - 1e-9:  # README: it rests within 1 % of a radius from 2 s on
             resting = max(resting, balls, walls)
     assert world.crowded_steps > 25  # it really landed as a crowd
     assert landing < 0.10

@@ -13,9 +13,13 @@ it moved, by the one factor that keeps what that stage must keep:
 - ``lift`` (penetration.py, and the soft frame's moving overlaps apart): positions moved apart lift
   balls against gravity; the potential energy that adds is paid out of the moved balls' kinetic energy,
   their velocities scaled (every direction of motion kept). A lowering is left alone.
-- ``frame`` (a soft frame as a whole, step/soft.py, where no plane moves): the velocities relative to
-  the centre of mass and the spins are scaled (momentum and every direction kept); when the springs
-  lifted the balls more than their motion can pay, the rising balls are taken back part way.
+- ``push`` (the split step's resting solve, resting.py): what its constant contact forces added over
+  an interval is paid out of the pushed balls' kinetic energy.
+- ``frame`` (a soft frame as a whole, step/soft.py, where no plane moves): the rising balls are taken
+  back a little, then the velocities relative to the centre of mass and the spins are scaled
+  (momentum and every direction kept); when the springs lifted the balls more than their motion can
+  pay, the rising balls are taken back further and every ball's velocity made its move over the
+  frame, so that the velocities always tell how the balls moved.
 
 Each guard is switched by ``Model.guards`` (``settings.EnergyGuards``, all on by default), so a test can show
 what each prevents; a world's results are those of the guards on.
@@ -24,10 +28,12 @@ what each prevents; a world's results are those of the guards on.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from ..core import exact
+from ..core.settings import GUARD_TAKE_BACK, INTERVAL_ROUNDING, TINY
 from ..core.state import State, V, W, X
 from ..dynamics.model import Model
 from .rows import ContactRows
@@ -77,6 +83,34 @@ def wave_scale(
     return None
 
 
+def keep_interval(model: Model, state: State, balls: np.ndarray, before: np.ndarray) -> None:
+    """Make sure an interval under the resting solve's constant forces added no energy to the balls
+    ``balls`` they pushed (``before``: their rows at its start): a converged solve leaves no pushing
+    contact separating, and its forces do no work, but one that is not (balls of a hundred to one) may
+    push a ball on. The gain, ΔE = ΔK − Σ m·g·Δx, is paid out of their kinetic energy (velocities and
+    spins scaled by √(1 − ΔE/K)), as a lift is (``pay_for_lift``); positions stay. Checked for the
+    integrators exact under constant forces (RK2, RK4: a path of bend 1): explicit Euler gains energy
+    in free fall on its own, and no moving plane, which may give energy."""
+    if not model.guards.push or model.integrator.bend != 1.0 or model.moving_planes() or balls.size == 0:
+        return
+    sph = model.spheres
+    mass, inertia = sph.mass[balls], 1.0 / sph.inv_inertia[balls]
+    rows = state.body[balls]
+    dot, total = exact.dot_rows, exact.correctly_rounded_total
+
+    def kinetic(r: np.ndarray) -> float:
+        return 0.5 * (total(mass * dot(r[:, V], r[:, V])) + total(inertia * dot(r[:, W], r[:, W])))
+
+    k1 = kinetic(rows)
+    fall = mass * dot(rows[:, X] - before[:, X], model.gravity)  # −ΔU per ball
+    gain = k1 - kinetic(before) - total(fall)
+    if gain <= INTERVAL_ROUNDING * (k1 + total(np.abs(fall))):  # rounding in exact sums of inexact terms
+        return
+    scale = math.sqrt(max(0.0, 1.0 - gain / k1)) if k1 > 0.0 else 0.0
+    state.body[balls, V] = rows[:, V] * scale
+    state.body[balls, W] = rows[:, W] * scale
+
+
 def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, partly: bool = False) -> None:
     """Take the potential energy a separation adds, ΔU = −Σ m·g·Δx, out of the moved balls' kinetic
     energy (their velocities scaled by √(1 − ΔU/K)), so removing overlaps never adds energy.
@@ -108,19 +142,21 @@ def pay_for_lift(model: Model, state: State, old: np.ndarray, new: np.ndarray, p
     state.body[moved, V] = v * scale
 
 
-def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray) -> None:
+def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray, dt: float = 0.0) -> None:
     """Take any energy the frame gained out of the balls ``balls`` it moved: with no moving plane doing
     work, a frame may lose energy (inelastic bounces, friction) but never gain it, yet pushing overlaps
-    apart lifts balls and a Jacobi restitution pass can overshoot. Their velocities relative to their
-    centre of mass (and their spins) are scaled by the one factor that gives back the energy they had
-    at ``before``, E = ½·m·v² + ½·I·ω² − m·g·x: momentum is kept, and so is every direction of motion.
+    apart lifts balls and a Jacobi restitution pass can overshoot. A gain of
+    E = Σ ½·m·v² + ½·I·ω² − m·g·x against ``before`` is given back in steps, each only as far as it is
+    left, so that the velocities still tell how the balls moved:
 
-    When the springs lifted the balls by more than all their motion relative to the centre of mass
-    can pay (a settled pile whose load shifted: the overlaps it sank into spring back), that motion
-    is stopped and the balls that rose are taken back towards where they started, each by the one
-    fraction λ of its rise that leaves the energy they had (the potential −m·g·x is linear in x, so
-    λ is exact); the balls that sank keep their places. The overlaps left are those of the frame's
-    start or less, and the next frames push them apart as far as energy allows."""
+    1. the balls that rose are taken back along their moves, each by at most GUARD_TAKE_BACK of its
+       radius (``_take_back``): their velocities stay as the frame made them;
+    2. their velocities relative to their centre of mass (and their spins) are scaled by one factor:
+       momentum is kept, and so is every direction of motion;
+    3. when that motion cannot pay, the frame is taken back part way (``_take_part_back``): every
+       move, velocity and spin by one fraction. A settled pile whose soft springs would lift it,
+       more than its motion can pay, is held where it is, still.
+    """
     if not model.guards.frame or model.moving_planes():  # a moving plane may do work on the balls
         return
     sleeping = state.sleep.asleep
@@ -131,7 +167,6 @@ def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray
     sph = model.spheres
     mass, inertia = sph.mass[balls], 1.0 / sph.inv_inertia[balls]
     g = model.gravity
-    old, new = before[balls], state.body[balls]
 
     def energy(rows: np.ndarray) -> tuple[float, float]:
         v, w, x = rows[:, V], rows[:, W], rows[:, X]
@@ -139,24 +174,136 @@ def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray
         potential = -mass * exact.dot_rows(x, g)
         return exact.total(kinetic), exact.total(potential)
 
+    def gain() -> float:  # what E rose by
+        k, u = energy(state.body[balls])
+        return k + u - k0 - u0
+
+    old = before[balls]
     k0, u0 = energy(old)
-    k1, u1 = energy(new)
-    if k1 + u1 <= k0 + u0:
+    if gain() > 0.0:
+        body = (mass, inertia, sph.radius[balls], g)
+        _give_back(state, balls, old, state.body[balls], body, (k0, u0, dt), gain)
+
+
+def _give_back(
+    state: State,
+    balls: np.ndarray,
+    old: np.ndarray,
+    new: np.ndarray,
+    body: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    start: tuple[float, float, float],
+    gain: Callable[[], float],
+) -> None:
+    """``hold_frame``'s three steps, for the balls ``balls`` (their ``old`` and ``new`` rows; their
+    masses, inertias, radii and gravity, ``body``; their energies K₀ and U₀ at the ``start``);
+    ``gain`` measures what is left to give back."""
+    mass, inertia, radius, g = body
+    k0, u0, dt = start
+    x0 = old[:, X]
+    rise = -mass * exact.dot_rows(new[:, X] - x0, g)
+    _take_back(new, x0, rise, GUARD_TAKE_BACK * radius, gain())
+    state.body[balls, 0:3] = new[:, X]
+    left = gain()
+    if left <= 0.0:
         return
     total = exact.total(mass)
     v, w = new[:, V], new[:, W]
     momentum = mass[:, None] * v
     v_cm = np.array([exact.total(momentum[:, i]) for i in range(3)]) / total
     k_cm = 0.5 * total * float(v_cm[0] ** 2 + v_cm[1] ** 2 + v_cm[2] ** 2)
+    k1 = 0.5 * exact.total(mass * exact.dot_rows(v, v) + inertia * exact.dot_rows(w, w))
     k_rel = k1 - k_cm
-    room = k0 + u0 - u1 - k_cm
-    scale = math.sqrt(room / k_rel) if room > 0.0 and k_rel > 0.0 else 0.0
-    state.body[balls, V] = v_cm + scale * (v - v_cm)
-    state.body[balls, W] = scale * w
-    if room < 0.0:  # the rise is more than the motion can pay: take the rising balls part way back
-        x0, x1 = old[:, X], new[:, X]
-        rise = -mass * exact.dot_rows(x1 - x0, g)
-        up = rise > 0.0
-        lifted = exact.total(np.where(up, rise, 0.0))
-        fraction = min(max(1.0 + room / lifted, 0.0), 1.0) if lifted > 0.0 else 1.0
-        state.body[balls[up], 0:3] = x0[up] + fraction * (x1[up] - x0[up])
+    room = k_rel - left  # the relative motion's energy, less the gain it is to pay
+    if room >= 0.0:
+        scale = math.sqrt(room / k_rel)
+        state.body[balls, V] = v_cm + scale * (v - v_cm)
+        state.body[balls, W] = scale * w
+        return
+    if dt > 0.0 and _tell_moves(state, balls, x0, new[:, X], mass, g, k0, dt):
+        return
+    u1 = -exact.total(mass * exact.dot_rows(new[:, X], g))
+    _take_part_back(state, balls, x0, new[:, X], k0, k1, u1 - u0)
+
+
+def _tell_moves(
+    state: State,
+    balls: np.ndarray,
+    x0: np.ndarray,
+    x1: np.ndarray,
+    mass: np.ndarray,
+    g: np.ndarray,
+    k0: float,
+    dt: float,
+) -> bool:
+    """When the motion cannot pay for the gain: each ball's velocity is made its move over the frame,
+    v = Δx/dt (spins stopped), the balls that sank keeping their moves and those that rose taken back
+    by one fraction f of theirs, the most that keeps the energy: with K_s, K_r the kinetic energies
+    of the sinking and rising balls' moves and D < 0, R > 0 the potential energy their moves add,
+    K_s + f²·K_r + D + f·R ≤ k0. False (nothing changed) when even f = 0 is too much."""
+    move = x1 - x0
+    du = -mass * exact.dot_rows(move, g)
+    up = du > 0.0
+    k = 0.5 * mass * exact.dot_rows(move, move) / (dt * dt)
+    k_s, k_r = exact.total(np.where(up, 0.0, k)), exact.total(np.where(up, k, 0.0))
+    d, r = exact.total(np.where(up, 0.0, du)), exact.total(np.where(up, du, 0.0))
+    c = k_s + d - k0
+    if c > 0.0:
+        return False
+    if k_r + r + c <= 0.0:
+        f = 1.0
+    elif k_r > 0.0:
+        f = (-r + math.sqrt(r * r - 4.0 * k_r * c)) / (2.0 * k_r)
+    else:
+        f = -c / r
+    f = min(max(f, 0.0), 1.0)
+    moved = np.where(up[:, None], f * move, move)
+    state.body[balls, 0:3] = x0 + moved
+    state.body[balls, V] = moved / dt
+    state.body[balls, W] = 0.0
+    return True
+
+
+def _take_part_back(
+    state: State, balls: np.ndarray, x0: np.ndarray, x1: np.ndarray, k0: float, k1: float, du: float
+) -> None:
+    """The last resort of ``hold_frame``, when the balls' motion relative to their centre of mass
+    cannot pay for the gain: the frame is taken back part way, every ball's move from ``x0`` to ``x1``,
+    its velocity and its spin by one fraction λ, so that the velocities still tell the moves:
+    x = x0 + λ·(x1 − x0), v = λ·v₁, ω = λ·ω₁. The energy is then k0 + u0 + (λ²·k1 + λ·du − k0) (``du`` =
+    u1 − u0 the potential energy the whole move added, linear in λ; ``k1`` the kinetic energy at the
+    frame's end), so λ is the larger root of λ²·k1 + λ·du = k0. A settled pile whose soft springs
+    would lift it, with no motion to pay for that, is held where it is, still."""
+    lam = (-du + math.sqrt(du * du + 4.0 * k1 * k0)) / (2.0 * k1) if k1 > 0.0 else k0 / du
+    lam = min(max(lam, 0.0), 1.0)
+    state.body[balls, 0:3] = x0 + lam * (x1 - x0)
+    state.body[balls, V] *= lam
+    state.body[balls, W] *= lam
+
+
+def _take_back(new: np.ndarray, x0: np.ndarray, rise: np.ndarray, cap: np.ndarray, gain: float) -> float:
+    """Take the balls that rose (``rise`` > 0, the potential energy their moves from ``x0`` added) back
+    along their moves, by one fraction t of each move, but each by at most ``cap`` (m): ball i by
+    t_i = min(t, τ_i), τ_i = min(1, cap_i/|Δx_i|), with t the least that gives back ``gain`` (J), or all
+    of it that the caps allow. The energy given back, Σ rise_i·t_i, is piecewise linear in t, with a
+    knee at each τ: found over the τ sorted. Changes the positions of ``new`` in place; returns the
+    energy given back."""
+    up = np.flatnonzero(rise > 0.0)
+    if up.size == 0:
+        return 0.0
+    move = new[up, 0:3] - x0[up]
+    length = exact.norm_rows(move)
+    tau = np.minimum(1.0, cap[up] / np.maximum(length, TINY))
+    order = np.argsort(tau, kind="stable")
+    tau_s, rise_s = tau[order], rise[up][order]
+    done = np.cumsum(rise_s * tau_s)  # what the balls up to each knee give back, taken back in full
+    left = np.append(np.cumsum(rise_s[::-1])[::-1][1:], 0.0)  # what the later ones rise
+    at_knee = done + tau_s * left
+    k = int(np.searchsorted(at_knee, gain))
+    if k == len(tau_s):
+        t = float(tau_s[-1])
+    else:
+        before_k = float(done[k - 1]) if k > 0 else 0.0
+        t = (gain - before_k) / float(rise_s[k] + left[k])
+    back = np.minimum(t, tau)
+    new[up, 0:3] = new[up, 0:3] - back[:, None] * move
+    return min(gain, float(at_knee[-1]))

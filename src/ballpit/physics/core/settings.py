@@ -141,6 +141,15 @@ SLOP = 0.01
 # Overlaps deeper than the slop are moved back to this fraction of it, not to it, so they are not
 # caught again next frame (separate.py) …
 SLOP_RETURN = 0.8
+# An interval under the resting solve's forces whose energy rose by less than this fraction of its
+# kinetic energy and the potential energy it exchanged gained it by rounding alone (1e-16 of them on
+# the bundled incline), and is left as it is (energy_guard.keep_interval).
+INTERVAL_ROUNDING = 1e-12
+# A soft frame that gained energy gives it back first by taking the balls that rose back along their
+# moves, each by at most this fraction of its radius (half the slop), keeping its velocity: a settled
+# pile's springs lift it by micrometres a frame, and stopping its motion for that instead hid the
+# motion the positions still made (energy_guard.hold_frame).
+GUARD_TAKE_BACK = 0.5 * SLOP
 # … and only the contacts a move of up to this many times the deepest deficit could reach take part:
 # the others, farther apart than that, cannot be closed by moving these apart.
 SEPARATE_REACH = 2.0
@@ -287,3 +296,4 @@ class EnergyGuards:
     impulses: bool = True
     lift: bool = True
     frame: bool = True
+    push: bool = True

@@ -135,7 +135,7 @@ def _try(
     others = np.ones(n, bool)
     others[balls] = False
     with step.profile.stage(Stage.ENERGY_GUARD):
-        energy_guard.hold_frame(model, state, body_before, balls)
+        energy_guard.hold_frame(model, state, body_before, balls, dt)
     if others.any():  # balls touching nothing this frame fly on the world's integrator
         with step.profile.stage(Stage.INTEGRATE):
             rows = state.body[others]

@@ -13,12 +13,12 @@ import numpy as np
 
 from ..collision import narrowphase, toi
 from ..collision.pairs import KeptPairs
-from ..contact import impacts, penetration, resting, rows
+from ..contact import energy_guard, impacts, penetration, resting, rows
 from ..core.contacts import ContactPoints
 from ..core.profile import Stage
 from ..core.settings import BROAD_PHASE_STEPS, MAX_INTERVALS
 from ..core.state import V, W
-from ..dynamics.forces import ConstantPerBall, free_acceleration
+from ..dynamics.forces import ConstantPerBall, ForceTerm, free_acceleration
 from .collide import Motion, measure
 from .context import Step, integrate_interval
 
@@ -97,9 +97,21 @@ def split_at_impacts(step: Step, motion: Motion, contacts: ContactPoints, pairs:
             return
         with prof.stage(Stage.TIME_OF_IMPACT):
             h = min(toi.next_impact(model, state, contacts, lin, remaining), remaining)
-        integrate_interval(step, forces, push, h)
+        _integrate(step, forces, push, h)
         step.events.close_interval(h / remaining)
         elapsed = dt if h >= remaining else elapsed + h
+
+
+def _integrate(step: Step, forces: list[ForceTerm], push: ConstantPerBall | None, h: float) -> None:
+    """``integrate_interval``, the energy the contact forces ``push`` added paid back out of the pushed
+    balls' speed (``energy_guard.keep_interval``)."""
+    if push is None:
+        integrate_interval(step, forces, push, h)
+        return
+    pushed = np.flatnonzero((push.lin != 0.0).any(axis=1) | (push.ang != 0.0).any(axis=1))
+    before = step.state.body[pushed]
+    integrate_interval(step, forces, push, h)
+    energy_guard.keep_interval(step.model, step.state, pushed, before)
 
 
 def _measure_again(
