@@ -158,9 +158,7 @@ def normal_impulse(
     """The new accumulated normal impulse that drives v_n towards ``target``, kept ≥ 0 (a contact
     pushes, never pulls): P + m_n·(target − v_n), less ``give``·P for a soft contact (m_n then carries
     the mass scale, ``give`` is the impulse scale k)."""
-    new = np.subtract(target, v_n)  # accumulated + m_n·(target − v_n), formed in one array
-    np.multiply(m_n, new, out=new)
-    np.add(accumulated, new, out=new)
+    new = accumulated + m_n * (target - v_n)
     if give is not None:
         new -= give * accumulated
     return np.maximum(new, 0.0, out=new)
