@@ -782,6 +782,27 @@ COINCIDENT_FORTY = replace(
     masses=(1.0,) * 40,
 )
 
+# The long search over main (seed 410, 2026-12-06, shrunk): a 5 mm, 0.1 kg ball in a corner of the box
+# and a 0.1 mm, 1 g one just above it along gravity (−2, −3, −2), RK2 at 0.1 s: in step 3, split at
+# impacts, the energy rose by 5.9e-5 J (of 0.83 J). Not fixed: a hundred to one again, as seed 301, but
+# pressed into three walls at once.
+CORNER_HUNDRED_TO_ONE = Turned(
+    gravity=(-2.0, -3.0, -2.0),
+    integrator="rk2",
+    dt=0.1,
+    positions=((-0.995, -0.995, -0.995), (-0.992055513627133, -0.992055513627133, -0.992055513627133)),
+    velocities=(_Z, _Z),
+    radii=(0.005, 0.0001),
+    masses=(0.1, 0.001),
+    restitution=1.0,
+    half=1.0,
+    turn=_Z,
+    squares=False,
+    wall_restitution=1.0,
+    wall_friction=0.0,
+    steps=40,
+)
+
 
 def check_turned_box(box: Turned) -> None:
     """Run ``box``: after every step no state is non-finite, no ball's centre is beyond a wall, and an
@@ -820,6 +841,7 @@ def test_no_ball_leaves_a_turned_box_under_explicit_euler_at_large_steps(box):
 
 
 @WIDE
+@example(CORNER_HUNDRED_TO_ONE).xfail(raises=AssertionError, reason="energy rises by 5.9e-5 J in step 3")
 @given(pressed_into_corners())
 def test_no_ball_pressed_into_an_edge_or_corner_leaves_a_turned_box(box):
     check_turned_box(box)
