@@ -22,6 +22,10 @@ import pytest
 import ballpit
 
 REPO = Path(__file__).resolve().parents[2]
+# This pytest process only ever renders headless (EGL). A test that imports a module importing OpenGL
+# (the renderer's constants) before the offscreen fixture ran must not fix PyOpenGL's loader to GLX for
+# the rest of the worker; the window processes choose their own (backend.py, subprocess_env).
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 
 @pytest.fixture(scope="session")
