@@ -15,9 +15,11 @@ $(VENV)/.ballpit: pyproject.toml
 	$(PY) -m pip install --quiet -e '.[video]'
 	touch $@
 
-$(VENV)/.installed: $(VENV)/.ballpit
-	$(PY) -m pip install --quiet -e '.[test]'
-	touch $@
+# one pip run for both sets (a second resolve and editable build cost make test seconds from a clone)
+$(VENV)/.installed: pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet -e '.[video,test]'
+	touch $(VENV)/.ballpit $@
 
 # With no display the viewer prints how to render offscreen instead; that is not a failure here.
 demo: $(VENV)/.ballpit

@@ -325,7 +325,15 @@ def ghosts_in_real_time(workdir: Path) -> dict:
         frames.append([shown.step, shown.ghost_step, len(shown.ghosts)])
     out: dict = {"frames": frames, "calls": [[c.label, c.instances] for c in viewer.renderer.draws.calls]}
     wd.press(viewer, "SPACE", frames=0)  # paused: a child that fell behind (a loaded machine) catches up
-    wd.pump_until(viewer, lambda: viewer._drawn_shown.ghost_step == viewer._drawn_shown.step, timeout=30)
+    # until the pause has reached the physics (the steps run ahead dropped, the run put back at the step
+    # shown) and the ghosts of that step are drawn: before it, an earlier frame may already agree
+    wd.pump_until(
+        viewer,
+        lambda: (
+            viewer._drawn_shown.ghost_step == viewer._drawn_shown.step == viewer.sim.timeline.history.current
+        ),
+        timeout=30,
+    )
     drawn = viewer._drawn_shown
     out["paused"] = [drawn.step, drawn.ghost_step, viewer.sim.timeline.history.current]
     pid = viewer.sim.ghost_host.pid
