@@ -126,6 +126,7 @@ def test_the_busy_share_is_near_zero_while_nothing_steps_and_near_one_while_step
     assert waiting < 0.1
 
 
+@pytest.mark.slow  # waits out seconds of a long step by design
 def test_stop_returns_at_once_in_the_middle_of_a_long_step():
     sim = Simulation(line_of_balls(3))
     started = threading.Event()
