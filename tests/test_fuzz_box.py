@@ -789,20 +789,14 @@ COINCIDENT_FORTY = replace(
 # and a 0.1 mm, 1 g one just above it along gravity (−2, −3, −2), RK2 at 0.1 s: in step 3, split at
 # impacts, the energy rose by 5.9e-5 J (of 0.83 J). Not fixed: a hundred to one again, as seed 301, but
 # pressed into three walls at once.
-CORNER_HUNDRED_TO_ONE = Turned(
+CORNER_HUNDRED_TO_ONE = replace(
+    COINCIDENT_MIXED_MASSES,
     gravity=(-2.0, -3.0, -2.0),
-    integrator="rk2",
     dt=0.1,
     positions=((-0.995, -0.995, -0.995), (-0.992055513627133, -0.992055513627133, -0.992055513627133)),
     velocities=(_Z, _Z),
     radii=(0.005, 0.0001),
     masses=(0.1, 0.001),
-    restitution=1.0,
-    half=1.0,
-    turn=_Z,
-    squares=False,
-    wall_restitution=1.0,
-    wall_friction=0.0,
     steps=40,
 )
 
