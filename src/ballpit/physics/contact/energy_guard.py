@@ -14,7 +14,8 @@ it moved, by the one factor that keeps what that stage must keep:
   balls against gravity; the potential energy that adds is paid out of the moved balls' kinetic energy,
   their velocities scaled (every direction of motion kept). A lowering is left alone.
 - ``push`` (the split step's resting solve, resting.py): what its constant contact forces added over
-  an interval is paid out of the pushed balls' kinetic energy.
+  an interval is paid out of the pushed balls' kinetic energy, or, when they lifted the balls more
+  than that can pay, the interval is taken back part way (as the frame guard's last resort).
 - ``frame`` (a soft frame as a whole, step/soft.py, where no plane moves): the rising balls are taken
   back a little, then the velocities relative to the centre of mass and the spins are scaled
   (momentum and every direction kept); when the springs lifted the balls more than their motion can
