@@ -405,10 +405,12 @@ def busy_panel(workdir: Path) -> dict:
     pacing.PANEL_BUSY_HZ = 0.1  # once in ten seconds: what follows is within that, however loaded
     first = grab(viewer)[:, :width]  # built: the first frame while busy
     built = backend.builds, backend.redraws
+    uploads = backend.renderer.uploads
     same = []
     for _ in range(4):  # (a stray X event, the window's own, may make one of them build)
         same.append(bool(np.array_equal(grab(viewer)[:, :width], first)))
     out: dict = {"quick": [backend.builds - built[0], backend.redraws - built[1]]}
+    out["uploads"] = backend.renderer.uploads - uploads  # ImGui's triangles sent to GL in those frames
     out["same_pixels"] = all(same)
     out["panel_pixels"] = int((first.max(axis=-1) > 0).sum())
     x, y, w, h = viewer.panel.rects["section Scenes"]

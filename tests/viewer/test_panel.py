@@ -31,11 +31,12 @@ def run_scenario(display: str, name: str, workdir: Path) -> dict:
     return run_driver(DRIVER, display, name, workdir, timeout=240, batch=BATCH if name in BATCH else ())
 
 
-def test_while_the_physics_is_busy_frames_draw_the_panels_last_build_again_until_input_comes(xvfb, tmp_path):
+def test_while_the_physics_is_busy_frames_redraw_the_panels_last_build_from_its_buffers(xvfb, tmp_path):
     r = run_scenario(xvfb, "busy_panel", tmp_path)
     builds, redraws = r["quick"]  # of the next four frames: with no input, no build
     assert builds + redraws == 4 and redraws >= 2
     assert r["same_pixels"] and r["panel_pixels"] > 10_000  # and drawn it is, pixel for pixel
+    assert r["uploads"] == builds  # from the buffers that hold it: a redraw uploads nothing again
     assert r["after_pointer"] >= 1  # input: built again
     assert r["at_ease"] == 3
 

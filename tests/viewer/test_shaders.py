@@ -75,3 +75,29 @@ def test_a_link_error_names_both_shaders(offscreen, tmp_path):
     )  # no main
     with pytest.raises(ShaderError, match=r"a\.vert \+ b\.frag failed to link"):
         Program("a.vert", "b.frag", tmp_path)
+
+
+def test_a_uniform_already_holding_the_value_set_is_not_sent_again_and_a_new_value_is(offscreen):
+    import numpy as np
+    from OpenGL import GL
+
+    from ballpit.viewer.shaders import Program
+
+    program = Program("line.vert", "line.frag")
+    program.use()
+    loc = program.location("u_view_projection")
+    first = np.arange(16, dtype=np.float32).reshape(4, 4)
+    program.set("u_view_projection", first)
+    program.set("u_view_projection", first.copy())  # the same value: not sent
+    assert program.uniform_calls == 1
+    second = first + 0.5
+    program.set("u_view_projection", second)
+    assert program.uniform_calls == 2
+    held = np.zeros(16, dtype=np.float32)
+    GL.glGetUniformfv(program.id, loc, held)
+    assert np.array_equal(held.reshape(4, 4), second)  # GL holds the value set last
+    program.set("u_view_projection", first)  # back to an earlier value: sent, as GL holds another
+    GL.glGetUniformfv(program.id, loc, held)
+    assert program.uniform_calls == 3 and np.array_equal(held.reshape(4, 4), first)
+    GL.glUseProgram(0)
+    program.delete()

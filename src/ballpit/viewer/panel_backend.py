@@ -32,7 +32,11 @@ class _Renderer(PygletProgrammablePipelineRenderer):
     alone. The viewer draws nothing after the panel in a frame, and its next frame sets the state each
     of its passes needs, except what is restored here."""
 
-    def render(self, draw_data: imgui.ImDrawData) -> None:
+    def render(self, draw_data: imgui.ImDrawData, fresh: bool = True) -> None:
+        """Draw ImGui's triangles. Every draw list goes into the same two buffers, one after another, so
+        not ``fresh`` (the same draw data as last time, drawn again) the buffers still hold them all and
+        nothing is uploaded. A command binds its texture and sets its clip rectangle only when they
+        differ from the command before it."""
         io = self.io
         width, height = io.display_size
         fb_width = int(width * io.display_framebuffer_scale[0])
@@ -40,7 +44,8 @@ class _Renderer(PygletProgrammablePipelineRenderer):
         self._update_textures()
         if fb_width == 0 or fb_height == 0:
             return
-        draw_data.scale_clip_rects(io.display_framebuffer_scale)
+        if fresh:
+            draw_data.scale_clip_rects(io.display_framebuffer_scale)
         enabled = {cap: gl.glIsEnabled(cap) for cap in (gl.GL_BLEND, gl.GL_CULL_FACE, gl.GL_DEPTH_TEST)}
         viewport = gl.glGetIntegerv(gl.GL_VIEWPORT)
         gl.glEnable(gl.GL_BLEND)
@@ -58,26 +63,11 @@ class _Renderer(PygletProgrammablePipelineRenderer):
         gl.glUniform1i(self._attrib_location_tex, 0)
         gl.glUniformMatrix4fv(self._attrib_proj_mtx, 1, gl.GL_FALSE, projection)
         gl.glBindVertexArray(self._vao_handle)
-        index_type = gl.GL_UNSIGNED_SHORT if imgui.INDEX_SIZE == 2 else gl.GL_UNSIGNED_INT
-        for commands in draw_data.cmd_lists:
-            for target, handle, data, size in (
-                (gl.GL_ARRAY_BUFFER, self._vbo_handle, commands.vtx_buffer, imgui.VERTEX_SIZE),
-                (gl.GL_ELEMENT_ARRAY_BUFFER, self._elements_handle, commands.idx_buffer, imgui.INDEX_SIZE),
-            ):
-                gl.glBindBuffer(target, handle)
-                gl.glBufferData(
-                    target, data.size() * size, ctypes.c_void_p(data.data_address()), gl.GL_STREAM_DRAW
-                )
-            for command in commands.cmd_buffer:
-                gl.glBindTexture(gl.GL_TEXTURE_2D, command.tex_ref.get_tex_id())
-                x, y, z, w = command.clip_rect
-                gl.glScissor(int(x), int(fb_height - w), int(z - x), int(w - y))
-                gl.glDrawElements(
-                    gl.GL_TRIANGLES,
-                    command.elem_count,
-                    index_type,
-                    ctypes.c_void_p(command.idx_offset * imgui.INDEX_SIZE),
-                )
+        lists = draw_data.cmd_lists
+        if fresh or self._bases is None:
+            self._bases = self._upload(lists)
+        for commands, (base_vertex, base_index) in zip(lists, self._bases, strict=True):
+            self._draw_list(commands, fb_height, base_vertex, base_index)
         gl.glDisable(gl.GL_SCISSOR_TEST)
         for cap, on in enabled.items():
             (gl.glEnable if on else gl.glDisable)(cap)
@@ -85,6 +75,55 @@ class _Renderer(PygletProgrammablePipelineRenderer):
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
         self._handle_mouse_cursor()
+
+    def _upload(self, lists: list[imgui.ImDrawList]) -> list[tuple[int, int]]:
+        """Every draw list's vertices and indices into the two buffers, one after another; returns where
+        each list starts (its first vertex, its first index)."""
+        vertices = sum(commands.vtx_buffer.size() for commands in lists)
+        indices = sum(commands.idx_buffer.size() for commands in lists)
+        gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self._vbo_handle)
+        gl.glBufferData(gl.GL_ARRAY_BUFFER, vertices * imgui.VERTEX_SIZE, None, gl.GL_STREAM_DRAW)
+        gl.glBindBuffer(gl.GL_ELEMENT_ARRAY_BUFFER, self._elements_handle)
+        gl.glBufferData(gl.GL_ELEMENT_ARRAY_BUFFER, indices * imgui.INDEX_SIZE, None, gl.GL_STREAM_DRAW)
+        bases, vertex, index = [], 0, 0
+        for commands in lists:
+            bases.append((vertex, index))
+            for target, data, size, at in (
+                (gl.GL_ARRAY_BUFFER, commands.vtx_buffer, imgui.VERTEX_SIZE, vertex),
+                (gl.GL_ELEMENT_ARRAY_BUFFER, commands.idx_buffer, imgui.INDEX_SIZE, index),
+            ):
+                gl.glBufferSubData(
+                    target, at * size, data.size() * size, ctypes.c_void_p(data.data_address())
+                )
+            vertex += commands.vtx_buffer.size()
+            index += commands.idx_buffer.size()
+        self.uploads += 1
+        return bases
+
+    def _draw_list(
+        self, commands: imgui.ImDrawList, fb_height: int, base_vertex: int, base_index: int
+    ) -> None:
+        """The commands of one of ImGui's draw lists, whose vertices and indices start at ``base_vertex``
+        and ``base_index`` in the buffers."""
+        index_type = gl.GL_UNSIGNED_SHORT if imgui.INDEX_SIZE == 2 else gl.GL_UNSIGNED_INT
+        texture, clip = None, None
+        for command in commands.cmd_buffer:
+            tex = command.tex_ref.get_tex_id()
+            if tex != texture:
+                gl.glBindTexture(gl.GL_TEXTURE_2D, tex)
+                texture = tex
+            x, y, z, w = command.clip_rect
+            rect = (int(x), int(fb_height - w), int(z - x), int(w - y))
+            if rect != clip:
+                gl.glScissor(*rect)
+                clip = rect
+            gl.glDrawElementsBaseVertex(
+                gl.GL_TRIANGLES,
+                command.elem_count,
+                index_type,
+                ctypes.c_void_p((base_index + command.idx_offset) * imgui.INDEX_SIZE),
+                base_vertex + command.vtx_offset,
+            )
 
 
 class PanelBackend:
@@ -102,6 +141,8 @@ class PanelBackend:
             io.font_default = io.fonts.add_font_from_file_ttf(str(font), FONT_SIZE)
         self.renderer = _Renderer(window, attach_callbacks=False)
         self.renderer._window = window
+        self.renderer._bases = None  # where each draw list drawn last starts in the GL buffers
+        self.renderer.uploads = 0  # frames whose draw lists were uploaded to the GL buffers
         self._last = time.perf_counter()
         self._pointer: tuple[float, float] | None = None
         self.fed = True  # input came since the last build: the next frame builds the panel again
@@ -179,13 +220,12 @@ class PanelBackend:
 
     def redraw(self) -> bool:
         """Draw the last built frame again (ImGui keeps its draw data until the next ``new_frame``);
-        False, drawing nothing, when input came since or there is no frame to draw (or the clip
-        rectangles would be scaled again: a framebuffer scale other than 1)."""
+        False, drawing nothing, when input came since or there is no frame to draw. Its clip rectangles
+        were scaled to the framebuffer when it was built, and are not scaled again."""
         self.activate()
-        scale = tuple(imgui.get_io().display_framebuffer_scale)
-        if self.fed or not self._built or scale != (1.0, 1.0):
+        if self.fed or not self._built:
             return False
-        self.renderer.render(imgui.get_draw_data())
+        self.renderer.render(imgui.get_draw_data(), fresh=False)
         self.redraws += 1
         return True
 

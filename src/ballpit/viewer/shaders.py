@@ -93,7 +93,12 @@ def compile_shader(name: str, directory: Traversable | Path | None = None) -> in
 
 
 class Program:
-    """A linked vertex + fragment program with cached uniform locations."""
+    """A linked vertex + fragment program with cached uniform locations.
+
+    A uniform keeps its value in the program between frames, so a ``set`` of the value it already
+    holds is skipped: most of a frame's uniforms (fog, sun, the shadow casters) are the same every
+    frame, and each GL call through PyOpenGL costs the window's thread tens of microseconds of Python.
+    """
 
     def __init__(self, vertex: str, fragment: str, directory: Traversable | Path | None = None) -> None:
         from OpenGL import GL
@@ -113,28 +118,35 @@ class Program:
             GL.glDeleteProgram(program)
             raise ShaderError(f"shader program {self.name} failed to link:\n{log.strip()}")
         self.id = program
+        self._gl = GL
         self._locations: dict[str, int] = {}
+        self._values: dict[int, bytes | int] = {}  # the value each uniform location holds, as set last
+        self.uniform_calls = 0  # uniforms sent to GL (a set of the value held is not sent)
 
     def use(self) -> None:
-        from OpenGL import GL
-
-        GL.glUseProgram(self.id)
+        self._gl.glUseProgram(self.id)
 
     def location(self, uniform: str) -> int:
-        if uniform not in self._locations:
-            from OpenGL import GL
+        loc = self._locations.get(uniform)
+        if loc is None:
+            loc = self._locations[uniform] = self._gl.glGetUniformLocation(self.id, uniform)
+        return loc
 
-            self._locations[uniform] = GL.glGetUniformLocation(self.id, uniform)
-        return self._locations[uniform]
+    def _changed(self, loc: int, value: bytes | int) -> bool:
+        """Whether uniform ``loc`` needs ``value`` sent (it holds another); remembers it as held."""
+        if loc < 0 or self._values.get(loc) == value:
+            return False
+        self._values[loc] = value
+        self.uniform_calls += 1
+        return True
 
     def set(self, uniform: str, value: object) -> None:
         """Set a float, vec2/3/4 or mat4 uniform from a number or array (the program must be in use)."""
-        from OpenGL import GL
-
+        GL = self._gl
         loc = self.location(uniform)
-        if loc < 0:
-            return  # optimised away by the driver
         arr = np.asarray(value, dtype=np.float32)
+        if not self._changed(loc, arr.tobytes()):
+            return  # optimised away by the driver, or holding this value already
         if arr.shape == (4, 4):
             GL.glUniformMatrix4fv(loc, 1, GL.GL_FALSE, np.ascontiguousarray(arr))
         elif arr.ndim == 0:
@@ -145,32 +157,25 @@ class Program:
 
     def set_array(self, uniform: str, values: np.ndarray) -> None:
         """Set a uniform array of vec2 or vec3 from a (K, 2) or (K, 3) array."""
-        from OpenGL import GL
-
+        GL = self._gl
         loc = self.location(uniform)
         arr = np.ascontiguousarray(values, dtype=np.float32)
-        if loc >= 0 and len(arr):
+        if len(arr) and self._changed(loc, arr.tobytes()):
             setter = {2: GL.glUniform2fv, 3: GL.glUniform3fv}[arr.shape[-1]]
             setter(loc, len(arr), arr)
 
     def set_int_array(self, uniform: str, values: np.ndarray) -> None:
         """Set a uniform int array."""
-        from OpenGL import GL
-
         loc = self.location(uniform)
         arr = np.ascontiguousarray(values, dtype=np.int32)
-        if loc >= 0 and len(arr):
-            GL.glUniform1iv(loc, len(arr), arr)
+        if len(arr) and self._changed(loc, b"i" + arr.tobytes()):
+            self._gl.glUniform1iv(loc, len(arr), arr)
 
     def set_int(self, uniform: str, value: int) -> None:
         """Set an int uniform, such as the texture unit a sampler reads (the program must be in use)."""
-        from OpenGL import GL
-
         loc = self.location(uniform)
-        if loc >= 0:
-            GL.glUniform1i(loc, int(value))
+        if self._changed(loc, int(value)):
+            self._gl.glUniform1i(loc, int(value))
 
     def delete(self) -> None:
-        from OpenGL import GL
-
-        GL.glDeleteProgram(self.id)
+        self._gl.glDeleteProgram(self.id)
