@@ -50,16 +50,19 @@ def test_a_still_view_is_shown_again_rather_than_drawn_again_and_a_moving_one_is
     assert flying["frames"] > 2 and flying["views"] == flying["frames"], r  # the camera moves
 
 
-def test_pyglets_loop_draws_at_the_slow_rate_while_the_physics_is_behind_and_at_the_full_rate_paused(
+def test_pyglets_loop_draws_at_the_slow_rate_and_relabels_the_bar_less_while_the_physics_is_behind(
     xvfb, tmp_path
 ):
-    from ballpit.viewer.pacing import FAST_FPS, SLOW_FPS
+    from ballpit.viewer.pacing import FAST_FPS, HUD_BUSY_INTERVAL, SLOW_FPS
 
     r = run_driver(DRIVER, xvfb, "pacing", tmp_path, timeout=120)
     waiting, running, paused = r["waiting"], r["running"], r["paused"]
     assert waiting["interval"] == pytest.approx(1 / FAST_FPS), r
     assert running["busy"] > 0.9 and running["interval"] == pytest.approx(1 / SLOW_FPS), r
     assert 0 < running["fps"] < SLOW_FPS + 5, r  # the frames it leaves to the physics are not drawn
+    # the timeline bar's label (its time, new each frame) is laid out again as seldom as the HUD's text
+    gaps = running["label_gaps"]
+    assert len(gaps) >= 2 and min(gaps) >= HUD_BUSY_INTERVAL, r
     assert paused["busy"] < 0.5 and paused["interval"] == pytest.approx(1 / FAST_FPS), r
     assert paused["fps"] > 0, r
 

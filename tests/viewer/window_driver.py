@@ -7,6 +7,7 @@ the window, GL context, shaders and physics are all real. The last stdout line i
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -521,7 +522,8 @@ def escape_mid_step(workdir: Path) -> dict:
 def pacing(workdir: Path) -> dict:
     """pyglet's own loop (``Viewer.run``, as ``ballpit view``) on balls in 1/60 s steps that each take
     30 ms of wall time (about half real time), then paused: the redraw interval the window schedules
-    and the frames it draws in a second each way."""
+    and the frames it draws in a second each way; while running, the times between changes of the
+    timeline bar's label."""
     import pyglet
     from pyglet.window import key
 
@@ -541,6 +543,8 @@ def pacing(workdir: Path) -> dict:
         viewer.window.dispatch_event("on_key_press", symbol, 0)
         viewer.window.dispatch_event("on_key_release", symbol, 0)
 
+    labels: list = []  # when the timeline bar's label changed, while running
+
     def seen(name: str) -> None:
         frames, at = marks.pop(name)
         out[name] = {"interval": viewer._interval, "busy": viewer.physics.busy_fraction,
@@ -549,6 +553,9 @@ def pacing(workdir: Path) -> dict:
 
     def script(_dt: float) -> None:
         t = time.perf_counter() - started
+        changed = viewer.screen.label_changed
+        if "running" in marks and (not labels or labels[-1] != changed):
+            labels.append(changed)
         if t > 0.4 and "waiting" not in out:
             out["waiting"] = {"interval": viewer._interval}
             tap(key.X)
@@ -556,6 +563,7 @@ def pacing(workdir: Path) -> dict:
             marks["running"] = (viewer.frames, time.perf_counter())
         elif t > 3.5 and "running" in marks:
             seen("running")
+            out["running"]["label_gaps"] = [b - a for a, b in itertools.pairwise(labels)]
             tap(key.SPACE)
         elif t > 5.0 and "paused" not in out and "paused" not in marks:
             marks["paused"] = (viewer.frames, time.perf_counter())

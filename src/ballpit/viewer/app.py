@@ -348,6 +348,7 @@ class Viewer:
             self.physics.submit(lambda sim: (sim.file_changed(), sim.error), self._watched, rewind=False)
         self.camera.inset = self.panel.width / max(self.window.width, 1)
         self.screen.left = self.panel.width
+        self.screen.label_interval = self.pacer.hud_interval()  # the bar's time is text as the HUD's
         started = time.perf_counter()
         if dt is None:
             self.physics.run_free()

@@ -13,9 +13,10 @@ a frame in a fraction of a millisecond of CPU; there the physics rarely needs th
 
 While the physics is busy the frames drawn cost less too: the panel is built with ImGui at most
 ``PANEL_BUSY_HZ`` times a second (in between its last build is drawn again, unless input came) and the
-HUD's text laid out again every ``HUD_BUSY_INTERVAL`` (pyglet lays the whole text out again whenever
-it changes: a few ms of the window's thread). Both are work of the window's thread between frames
-that the physics does not get; the frames themselves are as many as before.
+HUD's text and the timeline bar's label laid out again every ``HUD_BUSY_INTERVAL`` (pyglet lays the
+whole text out again whenever it changes: a few ms of the window's thread). That is work of the
+window's thread between frames that the physics does not get; the frames themselves are as many as
+before.
 
 No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share and pace.
 """

@@ -65,6 +65,8 @@ class ScreenOverlay:
             "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, anchor_x="right", anchor_y="bottom"
         )
         self._label_at = 0.0  # when the bar's label may change next
+        self.label_changed = 0.0  # when it changed last (perf_counter)
+        self.label_interval = LABEL_INTERVAL  # the window sets it as the HUD's (longer while busy)
 
     @property
     def bar_shown(self) -> bool:
@@ -117,7 +119,7 @@ class ScreenOverlay:
             now = time.perf_counter()
             if self.bar_label.text != text and now >= self._label_at:
                 self.bar_label.text = text
-                self._label_at = now + LABEL_INTERVAL
+                self._label_at, self.label_changed = now + self.label_interval, now
             self.bar_label.x = width - BAR_MARGIN
             self.bar_label.y = BAR_MARGIN + BAR_HEIGHT + BAR_LABEL_GAP
         empty = np.zeros((0, VERTEX_WIDTH), dtype=np.float32)
