@@ -86,7 +86,8 @@ class FrameFeeder:
 
         ghosts = shown.ghosts
         if not ghosts:
-            self.renderer.upload_ghosts(np.zeros((0, 3)), np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3)))
+            if self.renderer.ghost_count:  # none drawn already: nothing to upload
+                self.renderer.upload_ghosts(np.zeros((0, 3)), np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3)))
             return
         self.renderer.upload_ghosts(
             np.concatenate([g[1] for g in ghosts]),

@@ -158,6 +158,7 @@ class Renderer:
         _attribute(3, 4, BALL_STRIDE, 8, divisor=1)
         self.ghost_count = 0
         self.ghost_alpha = 0.4
+        self._ghost_instances = np.zeros((0, BALL_STRIDE), dtype=np.float32)
 
         # planes: two triangles each, rebuilt when the scene changes or a plane moves
         self.plane_vao = GL.glGenVertexArrays(1)
@@ -307,12 +308,14 @@ class Renderer:
     ) -> None:  # fmt: skip
         """The ghost balls of every ghost world at once (one instanced draw), drawn with ``alpha``."""
         n = len(positions)
-        inst = np.zeros((n, BALL_STRIDE), dtype=np.float32)
+        if self._ghost_instances.shape[0] != n:
+            self._ghost_instances = np.zeros((n, BALL_STRIDE), dtype=np.float32)
+            self._ghost_instances[:, 11] = 1.0
+        inst = self._ghost_instances
         inst[:, 0:3] = positions
         inst[:, 3] = radii
         inst[:, 4:8] = orientations
         inst[:, 8:11] = colors
-        inst[:, 11] = 1.0
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self.ghost_vbo)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, inst.nbytes, inst if n else None, GL.GL_STREAM_DRAW)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, 0)
