@@ -71,7 +71,7 @@ class ContactColumns(Ends):
             v_a = np.take(v[:3], self.ends[:k][part], axis=1)
             v_b = np.take(v[:3], self.ends[k:][part], axis=1)
             surface = None if self.surface is None else self.surface[:, part]
-            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface)
+            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface, out=v_a)
         return vn
 
     def split(self, pushing: np.ndarray | None = None) -> None:

@@ -178,7 +178,7 @@ def _normal_sweep(
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
     vn = c.normal_speeds(vw)
-    new = model.normal_impulse(normal, m_n, target, vn, give)
+    new = model.normal_impulse(normal, m_n, target, vn, give, out=np.empty(k))
     d_n = np.subtract(new, normal, out=vn)  # in v_n's array, used up
     del vn
     if len(push) == 1:  # one row at a time (``apply``)
@@ -254,14 +254,16 @@ def _full_chunk(
     slip, spin = motion[0][:, part], motion[1][:, part]
     # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
     # (3, chunk) part at a time, each dropped once used
-    wa, wb = np.take(vw[3:], ea, axis=1), np.take(vw[3:], eb, axis=1)
+    wa = np.take(vw[3:], ea, axis=1)
+    wb = np.take(vw[3:], eb, axis=1)
     np.subtract(wa, wb, out=spin)  # the relative spin, for rolling resistance
-    lever = model.spin_lever(wa, wb, ra, rb)
-    del wa, wb
+    lever = model.spin_lever(wa, wb, ra, rb, in_place=True)  # in wa's array
     dv = np.take(vw[:3], ea, axis=1)
-    dv -= np.take(vw[:3], eb, axis=1)
-    rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part])
-    del lever
+    dv -= np.take(vw[:3], eb, axis=1, out=wb)
+    turn = exact.cross_cols(n, lever, out=wb)
+    del wa, wb
+    rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part], turn)
+    del lever, turn
     vn = exact.dot_cols(rel, n)
     old = normal[part]
     fresh = model.normal_impulse(old, _part(m_n, part), _part(target, part), vn, _part(give, part))
