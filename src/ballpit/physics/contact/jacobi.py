@@ -254,14 +254,19 @@ def _full_chunk(
     slip, spin = motion[0][:, part], motion[1][:, part]
     # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
     # (3, chunk) part at a time, each dropped once used
-    wa = np.take(vw[3:], ea, axis=1)
-    wb = np.take(vw[3:], eb, axis=1)
+    if k <= SWEEP_CHUNK:  # one chunk: both ends' velocities and spins in one gather
+        both = vw.take(c.ends, axis=1)
+        wa, wb, dv, vb = both[3:, :k], both[3:, k:], both[:3, :k], both[:3, k:]
+    else:
+        wa, wb = vw[3:].take(ea, axis=1), vw[3:].take(eb, axis=1)
+        dv = vb = None
     np.subtract(wa, wb, out=spin)  # the relative spin, for rolling resistance
     lever = model.spin_lever(wa, wb, ra, rb, in_place=True)  # in wa's array
-    dv = np.take(vw[:3], ea, axis=1)
-    dv -= np.take(vw[:3], eb, axis=1, out=wb)
+    if dv is None:
+        dv, vb = vw[:3].take(ea, axis=1), vw[:3].take(eb, axis=1, out=wb)
+    dv -= vb
     turn = exact.cross_cols(n, lever, out=wb)
-    del wa, wb
+    del wa, wb, vb
     rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part], turn)
     del lever, turn
     vn = exact.dot_cols(rel, n)
