@@ -15,10 +15,12 @@ $(VENV)/.ballpit: pyproject.toml
 	$(PY) -m pip install --quiet -e '.[video]'
 	touch $@
 
-# one pip run for both sets (a second resolve and editable build cost make test seconds from a clone)
+# one pip run for both sets (a second resolve and editable build cost make test seconds from a clone);
+# --no-compile: pip would byte-compile all 7,600 modules of the extras (scipy, matplotlib, MuJoCo...),
+# 18 of the install's 35 CPU-s; Python compiles the few hundred the tests import when they first do
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e '.[video,test]'
+	$(PY) -m pip install --quiet --no-compile -e '.[video,test]'
 	touch $(VENV)/.ballpit $@
 
 # With no display the viewer prints how to render offscreen instead; that is not a failure here.

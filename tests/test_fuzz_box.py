@@ -787,8 +787,10 @@ COINCIDENT_FORTY = replace(
 
 # The long search over main (seed 410, 2026-12-06, shrunk): a 5 mm, 0.1 kg ball in a corner of the box
 # and a 0.1 mm, 1 g one just above it along gravity (−2, −3, −2), RK2 at 0.1 s: in step 3, split at
-# impacts, the energy rose by 5.9e-5 J (of 0.83 J). Not fixed: a hundred to one again, as seed 301, but
-# pressed into three walls at once.
+# impacts, the energy rose by 5.9e-5 J (of 0.83 J): the resting solve, not converged at a hundred to
+# one, pushed the light ball out of the wedge between the heavy one and a wall, and its forces did
+# more work than the light ball's speed could pay back (now the interval is taken back part way,
+# energy_guard.keep_interval).
 CORNER_HUNDRED_TO_ONE = replace(
     COINCIDENT_MIXED_MASSES,
     gravity=(-2.0, -3.0, -2.0),
@@ -838,7 +840,7 @@ def test_no_ball_leaves_a_turned_box_under_explicit_euler_at_large_steps(box):
 
 
 @WIDE
-@example(CORNER_HUNDRED_TO_ONE).xfail(raises=AssertionError, reason="energy rises by 5.9e-5 J in step 3")
+@example(CORNER_HUNDRED_TO_ONE)
 @given(pressed_into_corners())
 def test_no_ball_pressed_into_an_edge_or_corner_leaves_a_turned_box(box):
     check_turned_box(box)

@@ -112,7 +112,8 @@ def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
     outside = ~((cols >= left) & (cols < right) & (rows >= top) & (rows < bottom))
     assert outside.sum() > 20
     # over the whole run, no ball is drawn under the HUD panel or off screen
-    track = np.array(r["track"])  # (frames, balls, (x, y, radius))
+    track = np.array(r["track"])  # (steps, balls, (x, y, radius))
+    assert len(track) >= 2300  # every step of the 10 s (240 a second)
     x, y, radius = track[..., 0], track[..., 1], track[..., 2]
     under_hud = (x + radius > left) & (x - radius < right) & (y + radius > top) & (y - radius < bottom)
     assert not under_hud.any()

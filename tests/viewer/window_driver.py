@@ -321,7 +321,9 @@ def hud_rectangle(viewer: Viewer) -> list[float]:
 
 
 def slopes_framing(workdir: Path) -> dict:
-    """The bundled demo in a default-sized window: where its balls are drawn over the whole run."""
+    """The bundled demo in a default-sized window: where its balls are drawn over the whole run, at every
+    physics step (the frames are drawn a quarter of a second apart: what is checked is where the camera
+    puts each state, and each state is projected with the camera of the frame that showed it)."""
     viewer = open_viewer(size=(1280, 720))  # no scene: the bundled slopes demo
     pump(viewer, 2)
     out: dict = {"size": [viewer.window.width, viewer.window.height], "scene": viewer.sim.appearance.name}
@@ -329,15 +331,17 @@ def slopes_framing(workdir: Path) -> dict:
     out["first_frame"] = screenshot(viewer).tolist()
     press(viewer, "X")
     radii = np.asarray(viewer.sim.world.spheres.radii)
+    stepped: list[np.ndarray] = []
+    viewer.sim.before_step.append(lambda: stepped.append(viewer.sim.world.spheres.positions.copy()))
     track = []
-    for _ in range(300):  # 10 s of simulated time
-        pump(viewer, 1, dt=1.0 / 30.0)
-        pixels, depth = viewer.camera.project(viewer.sim.world.spheres.positions, *out["size"])
-        radius = (
-            radii / depth * (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
-        )
-        track.append(np.column_stack([pixels, radius]).tolist())
-    out["track"] = track  # per frame, per ball: (x, y, radius) in pixels
+    for _ in range(40):  # 10 s of simulated time
+        pump(viewer, 1, dt=0.25)
+        for positions in stepped:
+            pixels, depth = viewer.camera.project(positions, *out["size"])
+            scale = (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
+            track.append(np.column_stack([pixels, radii / depth * scale]).tolist())
+        stepped.clear()
+    out["track"] = track  # per physics step, per ball: (x, y, radius) in pixels
     out["hud_after"] = hud_rectangle(viewer)
     out["bar_top"] = out["size"][1] - viewer.screen.bottom_clearance()  # the timeline bar and its label
     return out

@@ -14,7 +14,8 @@ it moved, by the one factor that keeps what that stage must keep:
   balls against gravity; the potential energy that adds is paid out of the moved balls' kinetic energy,
   their velocities scaled (every direction of motion kept). A lowering is left alone.
 - ``push`` (the split step's resting solve, resting.py): what its constant contact forces added over
-  an interval is paid out of the pushed balls' kinetic energy.
+  an interval is paid out of the pushed balls' kinetic energy, or, when they lifted the balls more
+  than that can pay, the interval is taken back part way (as the frame guard's last resort).
 - ``frame`` (a soft frame as a whole, step/soft.py, where no plane moves): the rising balls are taken
   back a little, then the velocities relative to the centre of mass and the spins are scaled
   (momentum and every direction kept); when the springs lifted the balls more than their motion can
@@ -88,9 +89,12 @@ def keep_interval(model: Model, state: State, balls: np.ndarray, before: np.ndar
     ``balls`` they pushed (``before``: their rows at its start): a converged solve leaves no pushing
     contact separating, and its forces do no work, but one that is not (balls of a hundred to one) may
     push a ball on. The gain, ΔE = ΔK − Σ m·g·Δx, is paid out of their kinetic energy (velocities and
-    spins scaled by √(1 − ΔE/K)), as a lift is (``pay_for_lift``); positions stay. Checked for the
-    integrators exact under constant forces (RK2, RK4: a path of bend 1): explicit Euler gains energy
-    in free fall on its own, and no moving plane, which may give energy."""
+    spins scaled by √(1 − ΔE/K)), as a lift is (``pay_for_lift``); positions stay. When the forces
+    lifted the balls more than their motion can pay (ΔE ≥ K: a light ball squeezed out of a wedge
+    rises, its speed spent), the interval is taken back part way, every move, velocity and spin by one
+    fraction (``_take_part_back``), so that the energy is what it was. Checked for the integrators
+    exact under constant forces (RK2, RK4: a path of bend 1): explicit Euler gains energy in free fall
+    on its own, and no moving plane, which may give energy."""
     if not model.guards.push or model.integrator.bend != 1.0 or model.moving_planes() or balls.size == 0:
         return
     sph = model.spheres
@@ -101,12 +105,15 @@ def keep_interval(model: Model, state: State, balls: np.ndarray, before: np.ndar
     def kinetic(r: np.ndarray) -> float:
         return 0.5 * (total(mass * dot(r[:, V], r[:, V])) + total(inertia * dot(r[:, W], r[:, W])))
 
-    k1 = kinetic(rows)
+    k0, k1 = kinetic(before), kinetic(rows)
     fall = mass * dot(rows[:, X] - before[:, X], model.gravity)  # −ΔU per ball
-    gain = k1 - kinetic(before) - total(fall)
+    gain = k1 - k0 - total(fall)
     if gain <= INTERVAL_ROUNDING * (k1 + total(np.abs(fall))):  # rounding in exact sums of inexact terms
         return
-    scale = math.sqrt(max(0.0, 1.0 - gain / k1)) if k1 > 0.0 else 0.0
+    if gain >= k1:  # the motion cannot pay: λ²·K₁ − λ·Σ m·g·Δx = K₀
+        _take_part_back(state, balls, before[:, X], rows[:, X], k0, k1, -total(fall))
+        return
+    scale = math.sqrt(1.0 - gain / k1)
     state.body[balls, V] = rows[:, V] * scale
     state.body[balls, W] = rows[:, W] * scale
 

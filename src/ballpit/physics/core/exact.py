@@ -166,8 +166,8 @@ def norm_cols(a: np.ndarray, scratch: np.ndarray | None = None, out: np.ndarray 
 def cross_cols(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """a × b of columns ((3, K) arrays), each component as ``np.cross`` forms it, into ``out`` if given
     (it must not overlap ``a`` or ``b``)."""
-    if out is None:
-        out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    if out is None:  # (np.broadcast_shapes costs more than a few columns' arithmetic)
+        out = np.empty(a.shape if a.shape == b.shape else np.broadcast_shapes(a.shape, b.shape))
     if a.ndim == b.ndim == 2 and out.shape[1] <= CROSS_GATHER_UP_TO:
         # a few columns: the rows a_j, b_k, a_k, b_j gathered for all three components at once, then
         # a_j·b_k − a_k·b_j in one pass (the same products and difference as component by component)
