@@ -63,15 +63,15 @@ class ContactColumns(Ends):
         columns."""
         k = self.k
         if k <= SWEEP_CHUNK:
-            g = np.take(v[:3], self.ends, axis=1)
-            return model.normal_speed(g[:, :k], g[:, k:], self.n, self.surface)
+            g = v[:3].take(self.ends, axis=1)
+            return model.normal_speed(g[:, :k], g[:, k:], self.n, self.surface, out=g[:, :k])
         vn = np.empty(k)  # SWEEP_CHUNK contacts at a time: the gathers of a chunk, not of all
         for lo in range(0, k, SWEEP_CHUNK):
             part = slice(lo, min(lo + SWEEP_CHUNK, k))
             v_a = np.take(v[:3], self.ends[:k][part], axis=1)
             v_b = np.take(v[:3], self.ends[k:][part], axis=1)
             surface = None if self.surface is None else self.surface[:, part]
-            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface)
+            vn[part] = model.normal_speed(v_a, v_b, self.n[:, part], surface, out=v_a)
         return vn
 
     def split(self, pushing: np.ndarray | None = None) -> None:
@@ -85,14 +85,18 @@ class ContactColumns(Ends):
             share = self.share
         else:
             counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
-            share = np.maximum(counts, 1.0)
+            share = np.maximum(counts, 1.0, out=counts)
         self.shares = share
         if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept
-            sa, sb = share[self.ends[:k]], share[self.ends[k:]]
-            self.m_n, m_t, m_r = model.effective_masses(
+            both = share.take(self.ends)
+            sa, sb = both[:k], both[k:]
+            inv_n, inv_t, inv_r = model.inverse_effective_masses(
                 sa * self.ima, sb * self.imb, sa * self.iia, sb * self.iib, self.ra, self.rb
             )
-            self.m_tr = np.stack((m_t, m_r))[:, None, :]
+            # model.effective_masses' reciprocals, m_t and m_r formed in their (2, 1, K) block
+            self.m_n, self.m_tr = np.divide(1.0, inv_n, out=inv_n), np.empty((2, 1, k))
+            np.divide(1.0, inv_t, out=self.m_tr[0, 0])
+            np.divide(1.0, inv_r, out=self.m_tr[1, 0])
             return
         if self.m_n is None:
             self.m_n = np.empty(k)

@@ -119,30 +119,50 @@ def contact_velocity(
     return point_velocity(v_a - v_b, spin_lever(w_a, w_b, arm_a, arm_b), n, surface)
 
 
-def spin_lever(w_a: np.ndarray, w_b: np.ndarray, arm_a: np.ndarray, arm_b: np.ndarray) -> np.ndarray:
-    """ρ_a·ω_a + ρ_b·ω_b: what the spins add to the contact point's velocity, crossed with n."""
+def spin_lever(
+    w_a: np.ndarray, w_b: np.ndarray, arm_a: np.ndarray, arm_b: np.ndarray, in_place: bool = False
+) -> np.ndarray:
+    """ρ_a·ω_a + ρ_b·ω_b: what the spins add to the contact point's velocity, crossed with n (formed
+    in ``w_a``'s and ``w_b``'s own arrays, used up, when ``in_place``)."""
+    if in_place:
+        w_a *= arm_a
+        w_a += np.multiply(w_b, arm_b, out=w_b)
+        return w_a
     lever = arm_a * w_a
     lever += arm_b * w_b
     return lever
 
 
 def point_velocity(
-    dv: np.ndarray, lever: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None
+    dv: np.ndarray,
+    lever: np.ndarray,
+    n: np.ndarray,
+    surface: np.ndarray | None = None,
+    turn: np.ndarray | None = None,
 ) -> np.ndarray:
     """``contact_velocity`` from the relative velocity ``dv`` = v_a − v_b (changed in place and
-    returned) and the ``spin_lever``: dv + n × lever − surface."""
-    dv += exact.cross_cols(n, lever)
+    returned) and the ``spin_lever``: dv + n × lever − surface (n × lever given as ``turn`` if it was
+    formed already)."""
+    dv += exact.cross_cols(n, lever) if turn is None else turn
     if surface is not None:
         dv -= surface
     return dv
 
 
 def normal_speed(
-    v_a: np.ndarray, v_b: np.ndarray, n: np.ndarray, surface: np.ndarray | None = None
+    v_a: np.ndarray,
+    v_b: np.ndarray,
+    n: np.ndarray,
+    surface: np.ndarray | None = None,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """Each contact's normal speed v_n = (v_a − v_b)·n (negative: closing), against a moving plane's
-    ``surface``; spin never changes it on spheres (a lever arm is parallel to n)."""
-    v_n = exact.dot_cols(v_a - v_b, n)
+    ``surface``; spin never changes it on spheres (a lever arm is parallel to n). With ``out`` ((3, K),
+    may be ``v_a``) the difference and the sums are formed in it, and v_n is its first row."""
+    if out is None:
+        v_n = exact.dot_cols(v_a - v_b, n)
+    else:
+        v_n = exact.dot_cols_in_place(np.subtract(v_a, v_b, out=out), n)
     if surface is not None:
         v_n -= exact.dot_cols(surface, n)
     return v_n
@@ -154,13 +174,22 @@ def normal_impulse(
     target: np.ndarray,
     v_n: np.ndarray,
     give: np.ndarray | float | None = None,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """The new accumulated normal impulse that drives v_n towards ``target``, kept ≥ 0 (a contact
     pushes, never pulls): P + m_n·(target − v_n), less ``give``·P for a soft contact (m_n then carries
-    the mass scale, ``give`` is the impulse scale k)."""
-    new = accumulated + m_n * (target - v_n)
-    if give is not None:
-        new -= give * accumulated
+    the mass scale, ``give`` is the impulse scale k). With ``out`` the impulses are formed in it and
+    ``v_n`` is used up as scratch (the same operations)."""
+    if out is None:
+        new = accumulated + m_n * (target - v_n)
+        if give is not None:
+            new -= give * accumulated
+    else:
+        change = np.subtract(target, v_n, out=v_n)
+        change *= m_n
+        new = np.add(accumulated, change, out=out)
+        if give is not None:
+            new -= np.multiply(give, accumulated, out=change)
     return np.maximum(new, 0.0, out=new)
 
 

@@ -178,7 +178,7 @@ def _normal_sweep(
     """One sweep of the normal impulses alone; ``vw`` changes in place."""
     k, n = c.k, c.n
     vn = c.normal_speeds(vw)
-    new = model.normal_impulse(normal, m_n, target, vn, give)
+    new = model.normal_impulse(normal, m_n, target, vn, give, out=np.empty(k))
     d_n = np.subtract(new, normal, out=vn)  # in v_n's array, used up
     del vn
     if len(push) == 1:  # one row at a time (``apply``)
@@ -254,14 +254,21 @@ def _full_chunk(
     slip, spin = motion[0][:, part], motion[1][:, part]
     # the contact-point velocity (contact_model.contact_velocity) from the balls' velocities gathered a
     # (3, chunk) part at a time, each dropped once used
-    wa, wb = np.take(vw[3:], ea, axis=1), np.take(vw[3:], eb, axis=1)
+    if k <= SWEEP_CHUNK:  # one chunk: both ends' velocities and spins in one gather
+        both = vw.take(c.ends, axis=1)
+        wa, wb, dv, vb = both[3:, :k], both[3:, k:], both[:3, :k], both[:3, k:]
+    else:
+        wa, wb = vw[3:].take(ea, axis=1), vw[3:].take(eb, axis=1)
+        dv = vb = None
     np.subtract(wa, wb, out=spin)  # the relative spin, for rolling resistance
-    lever = model.spin_lever(wa, wb, ra, rb)
-    del wa, wb
-    dv = np.take(vw[:3], ea, axis=1)
-    dv -= np.take(vw[:3], eb, axis=1)
-    rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part])
-    del lever
+    lever = model.spin_lever(wa, wb, ra, rb, in_place=True)  # in wa's array
+    if dv is None:
+        dv, vb = vw[:3].take(ea, axis=1), vw[:3].take(eb, axis=1, out=wb)
+    dv -= vb
+    turn = exact.cross_cols(n, lever, out=wb)
+    del wa, wb, vb
+    rel = model.point_velocity(dv, lever, n, None if c.surface is None else c.surface[:, part], turn)
+    del lever, turn
     vn = exact.dot_cols(rel, n)
     old = normal[part]
     fresh = model.normal_impulse(old, _part(m_n, part), _part(target, part), vn, _part(give, part))

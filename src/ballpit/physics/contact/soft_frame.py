@@ -60,6 +60,7 @@ class SoftFrame:
         self.constant = constant_acceleration(self.terms)
         kc = k.k
         self.n = k.n
+        self.k_ends = k.ends
         self.ends_a, self.ends_b = k.ends[:kc], k.ends[kc:]
         self.on_plane = self.rows.b == n_balls
         # the surface's own speed along the normal (moving planes), to move their side of s
@@ -130,10 +131,9 @@ class SoftFrame:
         moving plane's surface, moved by its speed along n for ``t``)."""
         d = self.x - self.x0
         k = len(self.ends_a)
-        if k <= SWEEP_CHUNK:
-            s = self.c.gap + exact.dot_cols(
-                np.take(d, self.ends_a, axis=1) - np.take(d, self.ends_b, axis=1), self.n
-            )
+        if k <= SWEEP_CHUNK:  # both ends gathered at once, their difference and its sums in place
+            g = d.take(self.k_ends, axis=1)
+            s = self.c.gap + exact.dot_cols_in_place(np.subtract(g[:, :k], g[:, k:], out=g[:, :k]), self.n)
         else:  # SWEEP_CHUNK contacts at a time: the (3, chunk) gathers of a chunk, not of all
             s = np.empty(k)
             for lo in range(0, k, SWEEP_CHUNK):

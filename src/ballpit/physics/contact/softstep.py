@@ -147,14 +147,32 @@ def solve(f: SoftFrame, i: int) -> None:
     gap."""
     k, vw, h = f.k, f.vw, f.h
     s = f.separation(i * h)
-    k.split((f.normal > 0.0) | (s + PUSH_AHEAD * np.minimum(k.normal_speeds(vw), 0.0) * h < 0.0))
+    # s + PUSH_AHEAD·min(v_n, 0)·h < 0, formed in v_n's array
+    ahead = k.normal_speeds(vw)
+    np.minimum(ahead, 0.0, out=ahead)
+    ahead *= PUSH_AHEAD
+    ahead *= h
+    np.add(s, ahead, out=ahead)
+    pushing = ahead < 0.0
+    pushing |= f.normal > 0.0
+    del ahead
+    k.split(pushing)
+    del pushing
     speculative = s > 0.0
-    target = np.where(speculative, -s / h, np.minimum(-f.soft("bias_rate") * (s - f.apart), MAX_PUSH))
+    # target = −s/h where speculative, else min(−(bias rate)·(s − apart), MAX_PUSH)
+    target = s - f.apart
+    rate = f.soft("bias_rate")
+    target *= np.negative(rate, out=rate)
+    del rate
+    np.minimum(target, MAX_PUSH, out=target)
+    np.divide(s, -h, out=target, where=speculative)
     del s
     # the sweeps' m_n·scale and give·m_n·(1/m_n unsplit), each formed in its own array
-    m_n = np.where(speculative, 1.0, f.soft("mass_scale"))
+    m_n = f.soft("mass_scale")
+    np.copyto(m_n, 1.0, where=speculative)
     m_n *= k.m_n
-    give = np.where(speculative, 0.0, f.soft("impulse_scale"))
+    give = f.soft("impulse_scale")
+    np.copyto(give, 0.0, where=speculative)
     del speculative
     give *= k.m_n
     give *= k.whole
@@ -165,15 +183,17 @@ def integrate_positions(f: SoftFrame) -> None:
     """x += v·h and q ← normalise(q + h·½·(ω, 0)⊗q); then what the checks need: each ball's largest move
     in a substep, how far it got from where it started, and the box around where it has been."""
     live = f.live
-    before = f.x[:, live].copy()
-    f.x[:, live] += f.vw[:3, live] * f.h
+    x = f.x[:, live]
+    before = x.copy()
+    x += f.vw[:3, live] * f.h
     quaternion.turn(f.q, f.vw[3:, live], f.h)
-    moved = f.x[:, live] - before
-    np.maximum(f.largest[live], exact.norm_cols(moved), out=f.largest[live])
-    del before, moved
-    np.maximum(f.farthest[live], exact.norm_cols(f.x[:, live] - f.x0[:, live]), out=f.farthest[live])
-    np.minimum(f.lo, f.x[:, live], out=f.lo)
-    np.maximum(f.hi, f.x[:, live], out=f.hi)
+    moved = np.subtract(x, before, out=before)  # its squares then formed in place (norm_cols)
+    length = np.empty(x.shape[1])
+    np.maximum(f.largest[live], exact.norm_cols(moved, moved, length), out=f.largest[live])
+    np.subtract(x, f.x0[:, live], out=moved)
+    np.maximum(f.farthest[live], exact.norm_cols(moved, moved, length), out=f.farthest[live])
+    np.minimum(f.lo, x, out=f.lo)
+    np.maximum(f.hi, x, out=f.hi)
 
 
 def relax(f: SoftFrame, i: int) -> None:
@@ -181,7 +201,9 @@ def relax(f: SoftFrame, i: int) -> None:
     separation seen, and the substep's impulses added to the frame's."""
     s = f.separation((i + 1) * f.h)
     np.minimum(f.least, s, out=f.least)
-    target = np.where(s > 0.0, -s / f.h, 0.0)
+    target = np.empty(len(s))
+    target.fill(0.0)
+    np.divide(s, -f.h, out=target, where=s > 0.0)  # −s/h where speculative
     del s
     # the soft update with mass scale 1 and no give, ΔP = m_n·(target − v_n): m_n·1 is m_n, and a give
     # of 0·P takes nothing from a finite P (and P − 0 is P), so the split m_n alone, with no (K,) arrays

@@ -143,6 +143,15 @@ def dot_cols(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
+def dot_cols_in_place(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``dot_cols`` formed in ``a``'s own rows (its values are used up): the same products, summed x,
+    y, z in the same order; returns ``a[0]``, which holds the sums."""
+    a *= b
+    a[0] += a[1]
+    a[0] += a[2]
+    return a[0]
+
+
 def norm_cols(a: np.ndarray, scratch: np.ndarray | None = None, out: np.ndarray | None = None) -> np.ndarray:
     """|a| of columns ((3, K)), its squares summed x, y, z in that order (``dot_cols``); into ``out``
     through ``scratch`` ((3, K)) when given, so a caller looping over chunks makes no temporaries."""

@@ -96,5 +96,6 @@ def turn(q: np.ndarray, w: np.ndarray, h: float) -> None:
     """q ← normalise(q + h·½·(ω, 0)⊗q), in place (``w`` is (3, M))."""
     dq = np.empty_like(q)
     derivative(q, w.T, dq)
-    q += h * dq
+    dq *= h
+    q += dq
     normalize(q, out=q)
