@@ -5,8 +5,7 @@ Under pytest-xdist (``make test``: ``-n auto --dist loadgroup``) the tests of a 
 window scenarios as one batch (a module-level ``BATCH``: tests/viewer/conftest.py's ``run_driver``)
 share one worker, so the batch runs once, not once on every worker its tests land on. So do the tests
 of a module that use one of the costly module-scoped fixtures it names in ``SHARED`` (a scene run, a
-pile settled first), so the fixture is made once. The ``slow`` and ``window`` tests are collected
-before the others."""
+pile settled first), so the fixture is made once."""
 
 from __future__ import annotations
 
@@ -32,9 +31,3 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         shared = set(getattr(module, "SHARED", ())).intersection(getattr(item, "fixturenames", ()))
         if getattr(module, "BATCH", None) or shared:
             item.add_marker(pytest.mark.xdist_group(module.__name__))
-    # Costly tests first: xdist hands out the groups (largest first) and then single tests in this
-    # order whenever a worker runs low, so the last to go are the cheap ones and neither worker is left
-    # finishing a long test alone at the end.
-    items.sort(
-        key=lambda item: item.get_closest_marker("slow") is None and item.get_closest_marker("window") is None
-    )
