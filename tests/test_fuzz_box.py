@@ -754,7 +754,7 @@ def _energy_scale(world: ballpit.World, half: float) -> float:
 # them, RK2 at 1/60 s: in step 7, split at impacts and integrated in one interval under the resting
 # solve's constant forces, the energy rose by 3.07 J (of 348 J): the solve, not converged at a hundred
 # to one, left pushing contacts separating, and its forces did work (now scaled down until they do
-# none, energy_guard.keep_push).
+# none, energy_guard.keep_interval).
 _MIXED = (0.01, 0.01, 0.01, 0.01, 0.015625, 0.03125, 0.01, *[1.0] * 17, *[0.0625] * 8, 0.125)
 COINCIDENT_MIXED_MASSES = Turned(
     gravity=(0.0, -9.81, 0.0),

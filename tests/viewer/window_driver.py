@@ -337,9 +337,9 @@ def slopes_framing(workdir: Path) -> dict:
     track = []
     for _ in range(40):  # 10 s of simulated time
         pump(viewer, 1, dt=0.25)
+        scale = (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
         for positions in stepped:
             pixels, depth = viewer.camera.project(positions, *out["size"])
-            scale = (out["size"][1] / 2) / math.tan(math.radians(viewer.camera.fov_y_degrees / 2))
             track.append(np.column_stack([pixels, radii / depth * scale]).tolist())
         stepped.clear()
     out["track"] = track  # per physics step, per ball: (x, y, radius) in pixels

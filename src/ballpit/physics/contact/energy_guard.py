@@ -187,9 +187,10 @@ def hold_frame(model: Model, state: State, before: np.ndarray, balls: np.ndarray
 
     old = before[balls]
     k0, u0 = energy(old)
-    if gain() > 0.0:
+    gained = gain()
+    if gained > 0.0:
         body = (mass, inertia, sph.radius[balls], g)
-        _give_back(state, balls, old, state.body[balls], body, (k0, u0, dt), gain)
+        _give_back(state, balls, old, state.body[balls], body, (k0, u0, dt), gained, gain)
 
 
 def _give_back(
@@ -199,16 +200,17 @@ def _give_back(
     new: np.ndarray,
     body: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     start: tuple[float, float, float],
+    gained: float,
     gain: Callable[[], float],
 ) -> None:
     """``hold_frame``'s three steps, for the balls ``balls`` (their ``old`` and ``new`` rows; their
-    masses, inertias, radii and gravity, ``body``; their energies K₀ and U₀ at the ``start``);
-    ``gain`` measures what is left to give back."""
+    masses, inertias, radii and gravity, ``body``; their energies K₀ and U₀ at the ``start``): what the
+    frame ``gained`` is given back; ``gain`` measures what is left of it after the first step."""
     mass, inertia, radius, g = body
     k0, u0, dt = start
     x0 = old[:, X]
     rise = -mass * exact.dot_rows(new[:, X] - x0, g)
-    _take_back(new, x0, rise, GUARD_TAKE_BACK * radius, gain())
+    _take_back(new, x0, rise, GUARD_TAKE_BACK * radius, gained)
     state.body[balls, 0:3] = new[:, X]
     left = gain()
     if left <= 0.0:
@@ -287,16 +289,15 @@ def _take_part_back(
     state.body[balls, W] *= lam
 
 
-def _take_back(new: np.ndarray, x0: np.ndarray, rise: np.ndarray, cap: np.ndarray, gain: float) -> float:
+def _take_back(new: np.ndarray, x0: np.ndarray, rise: np.ndarray, cap: np.ndarray, gain: float) -> None:
     """Take the balls that rose (``rise`` > 0, the potential energy their moves from ``x0`` added) back
     along their moves, by one fraction t of each move, but each by at most ``cap`` (m): ball i by
     t_i = min(t, τ_i), τ_i = min(1, cap_i/|Δx_i|), with t the least that gives back ``gain`` (J), or all
     of it that the caps allow. The energy given back, Σ rise_i·t_i, is piecewise linear in t, with a
-    knee at each τ: found over the τ sorted. Changes the positions of ``new`` in place; returns the
-    energy given back."""
+    knee at each τ: found over the τ sorted. Changes the positions of ``new`` in place."""
     up = np.flatnonzero(rise > 0.0)
     if up.size == 0:
-        return 0.0
+        return
     move = new[up, 0:3] - x0[up]
     length = exact.norm_rows(move)
     tau = np.minimum(1.0, cap[up] / np.maximum(length, TINY))
@@ -313,4 +314,3 @@ def _take_back(new: np.ndarray, x0: np.ndarray, rise: np.ndarray, cap: np.ndarra
         t = (gain - before_k) / float(rise_s[k] + left[k])
     back = np.minimum(t, tau)
     new[up, 0:3] = new[up, 0:3] - back[:, None] * move
-    return min(gain, float(at_knee[-1]))
