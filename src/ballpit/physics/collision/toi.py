@@ -30,6 +30,7 @@ def first_contact(
     tolerance: float | np.ndarray,
     max_iterations: int = MAX_ADVANCE_STEPS,
     start: np.ndarray | None = None,
+    overlap: float | None = None,
 ) -> np.ndarray:
     """Earliest time in [0, t_max] at which each pair's gap falls to ``tolerance`` (one for all, or
     one per pair; inf if none).
@@ -38,7 +39,8 @@ def first_contact(
     before which each pair cannot get there (inf: not within t_max at all): such pairs are left out,
     and a pair still advancing after LEAP_AFTER steps leaps ahead to its start. A pair still converging
     after ``max_iterations`` reports the time it reached, a safe lower bound: the caller advances to it
-    and asks again.
+    and asks again. With ``overlap`` (``merged``'s bound) a pair stops advancing, inf, once its
+    meeting can no longer change ``merged``'s answer (``past_merging``).
     """
     count = len(speed_bound)
     t = np.zeros(count)
@@ -57,6 +59,8 @@ def first_contact(
         if start is not None and iteration + 1 == LEAP_AFTER:
             t_next = np.maximum(t_next, start[active])
         within = t_next <= t_max
+        if overlap is not None:  # (t only grows: a pair meets at t_next or later)
+            within &= ~past_merging(when, speed_bound, t_next, overlap)
         active, t_next = active[within], t_next[within]
         if active.size == 0:
             return when
@@ -75,24 +79,54 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     IMPACT_OVERLAP of the smallest radius (removed next interval by moving positions). A lone impact is
     always met exactly.
     """
-    slop = model.contact_slop()
-    when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop)
+    slop, allowed = model.contact_slop(), IMPACT_OVERLAP * float(model.spheres.radius.min())
+    when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop, allowed)
+    return merged(when, bound, allowed)
+
+
+def merged(when: np.ndarray, bound: np.ndarray, allowed: float) -> float:
+    """The latest of the meeting times ``when`` (inf: none) that leaves every pair met before it
+    overlapping by at most ``allowed`` (m), each closing at its speed ``bound`` since it met, counted
+    from the first meeting; inf if none."""
     hit = np.isfinite(when)
     if not np.count_nonzero(hit):
         return np.inf
     order = np.argsort(when[hit], kind="stable")
     t, speed = when[hit][order], bound[hit][order]
     overlap = (t - t[0]) * np.maximum.accumulate(speed)
-    allowed = IMPACT_OVERLAP * float(model.spheres.radius.min())
     return float(t[np.searchsorted(overlap, allowed, side="right") - 1])
 
 
+def past_merging(when: np.ndarray, bound: np.ndarray, t: np.ndarray, allowed: float) -> np.ndarray:
+    """Which pairs that cannot meet before ``t`` are met too late to change ``merged(when, bound,
+    allowed)``, whenever they meet (a mask over ``t``; ``when``: the pairs met so far, inf the others).
+
+    With t₁ the earliest meeting so far and s₁ the least speed of the pairs met then, a pair meeting at
+    t′ ≥ t > t₁ is sorted after them and overlaps by (t′ − t₀)·(a running maximum ≥ s₁) ≥ (t − t₁)·s₁
+    in ``merged`` (t₀ ≤ t₁ the first meeting of all). Beyond ``allowed`` neither it nor any meeting
+    sorted after it is taken, and the meetings before it never see its speed: the answer is the same
+    without it (rounded products grow with their factors, so this holds in floating point too)."""
+    met = np.isfinite(when)
+    if not np.count_nonzero(met):
+        return np.zeros(t.shape, bool)
+    first = float(np.minimum.reduce(when[met]))
+    speed = float(np.minimum.reduce(bound[met & (when == first)]))
+    return (t - first) * speed > allowed
+
+
 def meetings(
-    model: Model, state: State, c: ContactPoints, accel: np.ndarray, h: float, target
+    model: Model,
+    state: State,
+    c: ContactPoints,
+    accel: np.ndarray,
+    h: float,
+    target,
+    overlap: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """When each pair of ``c`` not yet touching first has its gap down to ``target(r_a, r_b)`` within
     ``h`` (inf if never), with the closing-speed bound used, for the pairs that could get there at
-    all (their indices into ``c``)."""
+    all (their indices into ``c``); with ``overlap``, inf too for the pairs met too late to change
+    ``merged`` (``first_contact``)."""
     apart = (c.gap >= model.contact_slop()).nonzero()[0]
     none = np.zeros(0)
     if apart.size == 0:
@@ -138,7 +172,7 @@ def meetings(
         return exact.norm_rows(pa - pb) - reach[k]
 
     start = earliest(model, state, c, apart, x, v, acc, h, goal)
-    return first_contact(gap_at, bound, h, goal, start=start), bound, apart
+    return first_contact(gap_at, bound, h, goal, start=start, overlap=overlap), bound, apart
 
 
 def earliest(
