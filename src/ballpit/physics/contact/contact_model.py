@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -206,20 +207,38 @@ def within_limit(candidate: np.ndarray, limit: np.ndarray) -> np.ndarray:
     return candidate
 
 
-def stick(
-    slip: np.ndarray,
-    spin: np.ndarray,
-    n: np.ndarray,
+class StickTerms(NamedTuple):
+    """What ``stick`` needs of a contact that its masses and lever arms fix (``stick_terms``)."""
+
+    lean: np.ndarray  # c·m_r: the friction impulse a unit of n × spin asks for, times D
+    c: np.ndarray  # ρ_a/I_a − ρ_b/I_b
+    d: np.ndarray  # D
+    inv_r: np.ndarray  # 1/m_r
+
+
+def stick_terms(
     inv_mass_a: np.ndarray,
     inv_mass_b: np.ndarray,
     inv_inertia_a: np.ndarray,
     inv_inertia_b: np.ndarray,
     arm_a: np.ndarray,
     arm_b: np.ndarray,
+) -> StickTerms:
+    """``stick``'s c, D and 1/m_r of contacts with these inverse masses, inertias and lever-arm lengths,
+    formed once for every sweep of a solve."""
+    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, NO_ZERO_DIVIDE)
+    c = arm_a * inv_inertia_a - arm_b * inv_inertia_b
+    reach = arm_a + arm_b
+    d = (inv_mass_a + inv_mass_b) + inv_inertia_a * inv_inertia_b * reach * reach / inv_r
+    return StickTerms(c / inv_r, c, d, inv_r)
+
+
+def stick(
+    slip: np.ndarray, spin: np.ndarray, n: np.ndarray, terms: StickTerms
 ) -> tuple[np.ndarray, np.ndarray]:
     """The friction impulse P and rolling impulse R that together stop a contact's ``slip`` (its
     tangential contact-point velocity) and relative ``spin``: the two solved as one block, before the
-    friction cone and the rolling limit are applied.
+    friction cone and the rolling limit are applied (``terms``: the contacts' ``stick_terms``).
 
     Solved one after the other, each undoes part of the other: friction turns the ball, rolling
     resistance stops the turn, which leaves slip again, and a lone ball coming to rest keeps 5/7 of its
@@ -232,18 +251,14 @@ def stick(
     D = 1/m_t − c²·m_r = 1/m_a + 1/m_b + (ρ_a + ρ_b)²/(I_a·I_b·(1/I_a + 1/I_b)), which is at least
     1/m_a + 1/m_b (written so: against a plane, D is 1/m_a exactly).
     """
-    inv_r = np.maximum(inv_inertia_a + inv_inertia_b, NO_ZERO_DIVIDE)
-    c = arm_a * inv_inertia_a - arm_b * inv_inertia_b
-    reach = arm_a + arm_b
-    d = (inv_mass_a + inv_mass_b) + inv_inertia_a * inv_inertia_b * reach * reach / inv_r
     p = exact.cross_cols(n, spin)
-    p *= c / inv_r
+    p *= terms.lean
     p -= slip
-    p /= d
+    p /= terms.d
     r = exact.cross_cols(n, p)
-    r *= c
+    r *= terms.c
     r -= spin
-    r /= inv_r
+    r /= terms.inv_r
     return p, r
 
 

@@ -60,6 +60,12 @@ class _Colour:
         # on the surface speed a unit of rolling impulse changes (|ΔΩ|·ρ), for the convergence test
         self.lever = self.ra * self.iia - self.rb * self.iib
         self.max_roll = float(np.maximum.reduce(self.iia * self.ra + self.iib * self.rb))
+        # friction and rolling resistance solved as one block where both hold (``model.stick``)
+        self.stick = (
+            model.stick_terms(self.ima, self.imb, self.iia, self.iib, self.ra, self.rb)
+            if self.has_friction and self.has_rolling
+            else None
+        )
 
 
 def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
@@ -158,21 +164,23 @@ def _sweep_colour(
         # other, as below
         slip = rel - vn * c.n
         spin = wa - wb if c.spin is None else wa - wb - c.spin
-        p, r = model.stick(slip, spin, c.n, c.ima, c.imb, c.iia, c.iib, c.ra, c.rb)
+        p, r = model.stick(slip, spin, c.n, c.stick)
         old_t, old_r = friction[k], rolling[k]
         block_t, block_r = old_t + p, old_r + r
-        new_t = model.within_limit(old_t - c.m_t * slip, c.mu * new)
+        cone, limit = c.mu * new, c.rolling * new
+        new_t = model.within_limit(old_t - c.m_t * slip, cone)
         d_t = new_t - old_t
-        spin -= c.lever * model.turn(c.n, d_t)  # the relative spin after that friction's turn
-        new_r = model.within_limit(old_r - c.m_r * spin, c.rolling * new)
-        held = (exact.dot_cols(block_t, block_t) <= (c.mu * new) ** 2) & (
-            exact.dot_cols(block_r, block_r) <= (c.rolling * new) ** 2
-        )
-        new_t, new_r = np.where(held, block_t, new_t), np.where(held, block_r, new_r)
-        friction[k], rolling[k] = new_t, new_r
-        d_t, d_r = new_t - old_t, new_r - old_r
-        linear += d_t
         turn = model.turn(c.n, d_t)
+        spin -= c.lever * turn  # the relative spin after that friction's turn
+        new_r = model.within_limit(old_r - c.m_r * spin, limit)
+        held = (exact.dot_cols(block_t, block_t) <= cone**2) & (exact.dot_cols(block_r, block_r) <= limit**2)
+        if np.count_nonzero(held):  # (else the friction and its turn stay as found)
+            new_t, new_r = np.where(held, block_t, new_t), np.where(held, block_r, new_r)
+            d_t = new_t - old_t
+            turn = model.turn(c.n, d_t)
+        friction[k], rolling[k] = new_t, new_r
+        d_r = new_r - old_r
+        linear += d_t
         wa += c.turn_a * turn + c.iia * d_r
         wb += c.turn_b * turn - c.iib * d_r
         change = max(
