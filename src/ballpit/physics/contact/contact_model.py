@@ -251,15 +251,26 @@ def stick(
     D = 1/m_t − c²·m_r = 1/m_a + 1/m_b + (ρ_a + ρ_b)²/(I_a·I_b·(1/I_a + 1/I_b)), which is at least
     1/m_a + 1/m_b (written so: against a plane, D is 1/m_a exactly).
     """
+    p = block_friction(slip, spin, n, terms)
+    return p, block_rolling(p, spin, n, terms)
+
+
+def block_friction(slip: np.ndarray, spin: np.ndarray, n: np.ndarray, terms: StickTerms) -> np.ndarray:
+    """``stick``'s friction impulse P = (c·m_r·(n × spin) − slip)/D."""
     p = exact.cross_cols(n, spin)
     p *= terms.lean
     p -= slip
     p /= terms.d
+    return p
+
+
+def block_rolling(p: np.ndarray, spin: np.ndarray, n: np.ndarray, terms: StickTerms) -> np.ndarray:
+    """``stick``'s rolling impulse R = m_r·(c·(n × P) − spin), from its friction impulse ``p``."""
     r = exact.cross_cols(n, p)
     r *= terms.c
     r -= spin
     r /= terms.inv_r
-    return p, r
+    return r
 
 
 def separation_parts(inv_mass_a: np.ndarray, inv_mass_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -164,16 +164,19 @@ def _sweep_colour(
         # other, as below
         slip = rel - vn * c.n
         spin = wa - wb if c.spin is None else wa - wb - c.spin
-        p, r = model.stick(slip, spin, c.n, c.stick)
         old_t, old_r = friction[k], rolling[k]
-        block_t, block_r = old_t + p, old_r + r
         cone, limit = c.mu * new, c.rolling * new
+        p = model.block_friction(slip, spin, c.n, c.stick)
+        block_t = old_t + p
+        held = exact.dot_cols(block_t, block_t) <= cone**2
+        if np.count_nonzero(held):  # the block's rolling impulse matters only where its friction holds
+            block_r = old_r + model.block_rolling(p, spin, c.n, c.stick)
+            held &= exact.dot_cols(block_r, block_r) <= limit**2
         new_t = model.within_limit(old_t - c.m_t * slip, cone)
         d_t = new_t - old_t
         turn = model.turn(c.n, d_t)
         spin -= c.lever * turn  # the relative spin after that friction's turn
         new_r = model.within_limit(old_r - c.m_r * spin, limit)
-        held = (exact.dot_cols(block_t, block_t) <= cone**2) & (exact.dot_cols(block_r, block_r) <= limit**2)
         if np.count_nonzero(held):  # (else the friction and its turn stay as found)
             new_t, new_r = np.where(held, block_t, new_t), np.where(held, block_r, new_r)
             d_t = new_t - old_t
