@@ -64,20 +64,15 @@ class _Colour:
         stick = None
         if self.has_friction and self.has_rolling:
             stick = model.stick_terms(self.ima, self.imb, self.iia, self.iib, self.ra, self.rb)
-        # The factors the sweeps multiply into (3, K) vectors, as (3, K) rows holding the same values:
-        # a (K,) factor broadcast over three rows costs a NumPy call about three times a plain one.
-        self.ra, self.rb, self.ima, self.imb, self.iia, self.iib = map(
-            _rows3, (self.ra, self.rb, self.ima, self.imb, self.iia, self.iib)
-        )
-        self.m_t, self.m_r, self.turn_a, self.turn_b, self.lever = map(
-            _rows3, (self.m_t, self.m_r, self.turn_a, self.turn_b, self.lever)
-        )
-        self.stick = None if stick is None else model.StickTerms(*map(_rows3, stick))
-
-
-def _rows3(x: np.ndarray) -> np.ndarray:
-    """Per-contact values (K,) as three equal rows (3, K)."""
-    return np.tile(x, (3, 1))
+        # The factors the sweeps multiply into (3, K) vectors, as (3, K) rows holding the same values
+        # (made in one go): a (K,) factor broadcast over three rows costs a NumPy call about three
+        # times a plain one.
+        factors = [self.ra, self.rb, self.ima, self.imb, self.iia, self.iib]
+        factors += [self.m_t, self.m_r, self.turn_a, self.turn_b, self.lever, *(stick or ())]
+        rows = np.repeat(np.array(factors)[:, None, :], 3, axis=1)
+        self.ra, self.rb, self.ima, self.imb, self.iia, self.iib = rows[:6]
+        self.m_t, self.m_r, self.turn_a, self.turn_b, self.lever = rows[6:11]
+        self.stick = None if stick is None else model.StickTerms(*rows[11:])
 
 
 def warm_start(contacts: ContactRows, v: np.ndarray, w: np.ndarray, imp: Impulses) -> None:
