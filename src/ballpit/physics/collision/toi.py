@@ -79,7 +79,9 @@ def next_impact(model: Model, state: State, c: ContactPoints, accel: np.ndarray,
     IMPACT_OVERLAP of the smallest radius (removed next interval by moving positions). A lone impact is
     always met exactly.
     """
-    slop, allowed = model.contact_slop(), IMPACT_OVERLAP * float(model.spheres.radius.min())
+    # (inf with no balls: then no pair meets)
+    allowed = IMPACT_OVERLAP * float(model.spheres.radius.min(initial=np.inf))
+    slop = model.contact_slop()
     when, bound, _ = meetings(model, state, c, accel, h, lambda ra, rb: 0.5 * slop, allowed)
     return merged(when, bound, allowed)
 
