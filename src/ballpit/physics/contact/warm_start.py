@@ -72,13 +72,15 @@ class WarmStart:
             imp.rolling[to] = self.forces.rolling[at] * h
         return imp
 
-    def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> None:
-        """Remember the impulses found over ``h`` as forces, for the next solve."""
+    def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> np.ndarray:
+        """Remember the impulses found over ``h`` as forces, for the next solve; returns the order the
+        pairs ``keys`` are kept in (for ``keep_apart``)."""
         order = np.argsort(keys)
         self.keys = keys[order]
         parts = (imp.normal, imp.friction, imp.rolling)
         self.forces = Impulses(*(_divided(part[order], h) for part in parts))
         self.apart = np.zeros(len(keys))
+        return order
 
     def put_to_sleep(self, asleep: np.ndarray) -> None:
         """Put aside the kept forces of the pairs whose balls are all ``asleep`` (a plane counts as
@@ -114,9 +116,10 @@ class WarmStart:
         held[found] = self.apart[src]
         return held
 
-    def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
-        """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
-        self.apart = apart[np.argsort(keys)]
+    def keep_apart(self, apart: np.ndarray, order: np.ndarray) -> None:
+        """Remember ``apart`` for the pairs just kept by ``keep``, given as they were given to it;
+        ``order`` is the order it returned (the pairs are not sorted again)."""
+        self.apart = apart[order]
 
 
 def _on_tangent_plane(friction: np.ndarray, n: np.ndarray) -> np.ndarray:
