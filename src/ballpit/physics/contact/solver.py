@@ -161,7 +161,7 @@ def _sweep_smooth(
     rel += turn
     if c.surface is not None:
         rel -= c.surface
-    vn = exact.dot_cols(rel, c.n)
+    vn = exact.dot_cols_in_place(rel, c.n)
     old = normal[k]
     new = model.normal_impulse(old, c.m_n, target, vn)
     normal[k] = new
