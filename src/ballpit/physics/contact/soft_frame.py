@@ -75,8 +75,10 @@ class SoftFrame:
         # substeps (24 bytes a contact each)
         keys = c.keys()
         self.tangential = np.zeros((2, 3, kc))
-        self.normal = warm.impulses(keys, c.normal, h, self.tangential).normal
-        self.apart = warm.apart_of(keys)
+        at = warm.lookup(keys)
+        self.normal = warm.impulses(keys, c.normal, h, self.tangential, at).normal
+        self.apart = warm.apart_of(keys, at)
+        del at
         self.total = np.zeros(kc)
         self.least = c.gap.copy()
         self.farthest, self.largest = np.zeros(m), np.zeros(m)

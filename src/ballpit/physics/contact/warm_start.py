@@ -32,6 +32,11 @@ class WarmStart:
         """Put back the warm start ``saved`` (a ``checkpoint``; it stays usable)."""
         self.__dict__.update(vars(saved))
 
+    def lookup(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """Which of the pairs ``keys`` are kept, and where, as ``impulses`` and ``apart_of`` look them
+        up (a caller asking both for the same pairs looks them up once); None when nothing is kept."""
+        return self._found(keys) if len(self.keys) else None
+
     def _found(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Which of the pairs ``keys`` are kept, and where (the kept rows of those found)."""
         pos = np.searchsorted(self.keys, keys)
@@ -48,18 +53,23 @@ class WarmStart:
         return normal
 
     def impulses(
-        self, keys: np.ndarray, normal: np.ndarray, h: float, tangential: np.ndarray | None = None
+        self,
+        keys: np.ndarray,
+        normal: np.ndarray,
+        h: float,
+        tangential: np.ndarray | None = None,
+        at: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``; the friction
         and rolling impulses into ``tangential`` when given (zeros, (2, 3, K): ``jacobi.sweeps``' block)
-        as views of its rows, with no (K, 3) arrays of their own."""
+        as views of its rows, with no (K, 3) arrays of their own. ``at``: ``lookup(keys)``, if made."""
         if tangential is None:
             imp = Impulses.zeros(len(keys))
         else:
             imp = Impulses(np.zeros(len(keys)), tangential[0].T, tangential[1].T)
         if len(self.keys) == 0:
             return imp
-        found, src = self._found(keys)
+        found, src = self._found(keys) if at is None else at
         imp.normal[found] = self.forces.normal[src] * h
         if len(src) <= SWEEP_CHUNK:
             imp.friction[found] = _on_tangent_plane(self.forces.friction[src] * h, normal[found])
@@ -107,12 +117,13 @@ class WarmStart:
         self.keys, self.forces, self.apart = merged
         self.asleep = _rows(self.asleep, still)
 
-    def apart_of(self, keys: np.ndarray) -> np.ndarray:
-        """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept)."""
+    def apart_of(self, keys: np.ndarray, at: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+        """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept);
+        ``at``: ``lookup(keys)``, if made."""
         held = np.zeros(len(keys))
         if len(self.keys) == 0:
             return held
-        found, src = self._found(keys)
+        found, src = self._found(keys) if at is None else at
         held[found] = self.apart[src]
         return held
 
