@@ -92,11 +92,11 @@ class SoftFrame:
         count: int,
         m_n: np.ndarray | None = None,
         give: np.ndarray | None = None,
-        vn: np.ndarray | None = None,
+        speeds: list[np.ndarray] | None = None,
     ) -> None:
         """``count`` Jacobi sweeps of the soft normal update towards ``target`` (``jacobi.sweeps``,
-        friction and rolling in the last), from the frame's impulses to its new ones; ``vn``, if given,
-        is the contacts' normal speeds now (the first sweep's, used up). The sweeps take the old
+        friction and rolling in the last), from the frame's impulses to its new ones; ``speeds``, if given,
+        holds the contacts' normal speeds now (the first sweep's: taken and used up). The sweeps take the old
         impulses as scratch, and the frame lets go of them first, so that the old normal impulses go
         after the first sweep instead of being held through the rest (K floats)."""
         self.normal, self.tangential = jacobi.sweeps(
@@ -109,7 +109,7 @@ class SoftFrame:
             friction_every=count,
             m_n=m_n,
             give=give,
-            vn=vn,
+            speeds=speeds,
         )
 
     def _handed_over(self) -> np.ndarray:

@@ -147,9 +147,10 @@ def solve(f: SoftFrame, i: int) -> None:
     gap."""
     k, vw, h = f.k, f.vw, f.h
     s = f.separation(i * h)
-    # s + PUSH_AHEAD·min(v_n, 0)·h < 0; v_n is also the first sweep's (the velocities are the same then)
-    vn = k.normal_speeds(vw)
-    ahead = np.minimum(vn, 0.0)
+    # s + PUSH_AHEAD·min(v_n, 0)·h < 0; v_n is also the first sweep's (the velocities are the same
+    # then), handed over in a list that the sweeps empty, so that no frame holds it after that sweep
+    speeds = [k.normal_speeds(vw)]
+    ahead = np.minimum(speeds[0], 0.0)
     ahead *= PUSH_AHEAD
     ahead *= h
     np.add(s, ahead, out=ahead)
@@ -176,7 +177,7 @@ def solve(f: SoftFrame, i: int) -> None:
     del speculative
     give *= k.m_n
     give *= k.whole
-    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give, vn=vn)
+    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give, speeds=speeds)
 
 
 def integrate_positions(f: SoftFrame) -> None:
