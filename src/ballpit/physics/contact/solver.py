@@ -161,17 +161,24 @@ def _sweep_smooth(
     rel += turn
     if c.surface is not None:
         rel -= c.surface
-    vn = exact.dot_cols_in_place(rel, c.n)
-    old = normal[k]
-    new = model.normal_impulse(old, c.m_n, target, vn)
-    normal[k] = new
-    d_n = new - old
-    linear = d_n * c.n
+    d_n, linear = _normal_update(c, exact.dot_cols_in_place(rel, c.n), target, normal, k)
     va += c.ima * linear
     vb -= c.imb * linear
     v[:, c.a] = va
     v[:, c.b] = vb
     return float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
+
+
+def _normal_update(
+    c: _Colour, vn: np.ndarray, target: np.ndarray, normal: list, k: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The colour's new normal impulses from its normal speeds ``vn``, into ``normal[k]``; returns
+    their change d_n and the linear impulse d_n·n it adds."""
+    old = normal[k]
+    new = model.normal_impulse(old, c.m_n, target, vn)
+    normal[k] = new
+    d_n = new - old
+    return d_n, d_n * c.n
 
 
 def _sweep_colour(
@@ -184,12 +191,8 @@ def _sweep_colour(
     va, wa, vb, wb = ga[:3], ga[3:], gb[:3], gb[3:]
     rel = model.contact_velocity(va, wa, vb, wb, c.n, c.ra, c.rb, c.surface)
     vn = exact.dot_cols(rel, c.n)
-
-    old = normal[k]
-    new = model.normal_impulse(old, c.m_n, target, vn)
-    normal[k] = new
-    d_n = new - old
-    linear = d_n * c.n
+    d_n, linear = _normal_update(c, vn, target, normal, k)
+    new = normal[k]
     change = float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
 
     if c.has_friction and c.has_rolling:
