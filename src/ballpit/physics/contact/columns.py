@@ -22,7 +22,9 @@ class ContactColumns(Ends):
     cap, with their own effective masses and limits (zero limits where a material has none).
     """
 
-    def __init__(self, contacts: ContactRows) -> None:
+    def __init__(self, contacts: ContactRows, split: bool = True) -> None:
+        """The columns of ``contacts``, each ball's mass split among all its contacts (``split``; a
+        caller that splits before its first sweep, as a soft frame's solve does, says False)."""
         super().__init__(contacts.a, contacts.b)
         k, m = self.k, self.m
         self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
@@ -55,7 +57,8 @@ class ContactColumns(Ends):
         self.motion = np.empty((2, 3, k))
         self.m_n: np.ndarray | None = None
         self.m_tr: np.ndarray | None = None
-        self.split()
+        if split:
+            self.split()
 
     def normal_speeds(self, v: np.ndarray) -> np.ndarray:
         """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it

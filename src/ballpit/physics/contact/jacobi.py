@@ -80,6 +80,7 @@ def sweeps(
     m_n: np.ndarray | None = None,
     give: np.ndarray | float | None = None,
     converge: bool = False,
+    speeds: list[np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """``count`` Jacobi sweeps driving each contact's v_n to ≥ ``target``: ``vw`` ((6, M) velocities
     and spins, or (3, M) velocities for normal impulses alone) changes in place; returns the new
@@ -90,13 +91,18 @@ def sweeps(
     Every ``friction_every``-th sweep and the last also update friction and rolling resistance (None:
     normal impulses alone). ``m_n`` and ``give`` make the normal soft (``contact_model.normal_impulse``;
     the soft step); ``converge`` stops after a full sweep that changed no contact velocity by more
-    than CONVERGED."""
+    than CONVERGED. ``speeds``, if the caller has formed them, holds the contacts' normal speeds from ``vw``
+    as given (``c.normal_speeds``): a first sweep of normal impulses alone takes them out of the list and
+    uses them up instead of forming them, and nothing holds them after it."""
     m_n = c.m_n if m_n is None else m_n
+    vn = speeds.pop() if speeds else None
     for sweep in range(count):
         full = friction_every is not None and ((sweep + 1) % friction_every == 0 or sweep == count - 1)
         if not full:
-            normal = _normal_sweep(c, vw, c.push, normal, target, m_n, give)
+            normal = _normal_sweep(c, vw, c.push, normal, target, m_n, give, vn)
+            vn = None
             continue
+        vn = None
         normal, tangential, change = _full_sweep(
             c, vw, c.push, normal, tangential, target, c.motion, m_n, give, converge
         )
@@ -174,10 +180,13 @@ def _normal_sweep(
     target: np.ndarray,
     m_n: np.ndarray,
     give: np.ndarray | float | None,
+    vn: np.ndarray | None = None,
 ) -> np.ndarray:
-    """One sweep of the normal impulses alone; ``vw`` changes in place."""
+    """One sweep of the normal impulses alone; ``vw`` changes in place. ``vn``: the normal speeds from
+    ``vw``, if formed already (used up as scratch)."""
     k, n = c.k, c.n
-    vn = c.normal_speeds(vw)
+    if vn is None:
+        vn = c.normal_speeds(vw)
     new = model.normal_impulse(normal, m_n, target, vn, give, out=np.empty(k))
     d_n = np.subtract(new, normal, out=vn)  # in v_n's array, used up
     del vn

@@ -63,39 +63,54 @@ def separate(
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
     proportion to their split inverse masses. ``pos`` (N+1, 3) changes in place; row N is the world.
 
-    Every sweep works one coordinate at a time, on (K,) and (2K,) rows: the same operations in the same
-    order as on (3, K) blocks (v_n as ``exact.dot_cols`` sums it, each row added up as ``add_up``
-    does), without their memory."""
+    Up to SWEEP_CHUNK contacts a sweep works on (3, K) and (3, 2K) blocks, one gather and one
+    ``add_up`` each; beyond, one coordinate at a time, on (K,) and (2K,) rows: the same operations in
+    the same order (v_n as ``exact.dot_cols`` sums it, each row added up as ``add_up`` does), without
+    the blocks' memory."""
     e = Ends(a, b)
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
     ea, eb = ends[:k], ends[k:]
     fa, fb = contact_model.separation_parts(share[ea] * inv_mass_a, share[eb] * inv_mass_b)  # each end's part
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
-
-    def along() -> np.ndarray:  # n·(x_a − x_b) per contact, SWEEP_CHUNK contacts at a time
-        d = np.empty(k)
-        for lo in range(0, k, SWEEP_CHUNK):
-            part = slice(lo, lo + SWEEP_CHUNK)
-            a, b, out = ea[part], eb[part], d[part]
-            np.multiply(n[0, part], x[0].take(a) - x[0].take(b), out=out)
-            out += n[1, part] * (x[1].take(a) - x[1].take(b))
-            out += n[2, part] * (x[2].take(a) - x[2].take(b))
-        return d
-
-    start = along()
-    move = np.empty(2 * k)  # one coordinate's moves of every contact's a (:K) then b (K:)
+    start = _along(e, n, x).copy()  # (not the view of its gather's block)
+    move = np.empty((3, 2 * k) if k <= SWEEP_CHUNK else 2 * k)  # the moves of each contact's a, then b
     for _ in range(sweeps):
-        now = gap + along() - start
+        now = gap + _along(e, n, x) - start
         deficit = np.maximum(-now, 0.0)
+        if k <= SWEEP_CHUNK:
+            d = deficit * n
+            np.multiply(d, fa, out=move[:, :k])
+            np.multiply(d, fb, out=move[:, k:])
+            # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
+            summed = e.add_up(move)
+            summed /= share
+            x += summed
+            continue
         for r in range(3):
             d = deficit * n[r]
             np.multiply(d, fa, out=move[:k])
             np.multiply(d, fb, out=move[k:])
-            # averaging the split copies of a ball: its moves add up, each with its own share 1/n_b
             x[r] += e.add_row(move) / share
     pos[balls] = x.T
     pos[-1] = 0.0
+
+
+def _along(e: Ends, n: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """n·(x_a − x_b) per contact of ``e`` from the (3, M) positions ``x``: both ends gathered at once up
+    to SWEEP_CHUNK contacts, else SWEEP_CHUNK contacts at a time, a coordinate at a time."""
+    k, ea, eb = e.k, e.ends[: e.k], e.ends[e.k :]
+    if k <= SWEEP_CHUNK:
+        g = x.take(e.ends, axis=1)
+        return exact.dot_cols_in_place(np.subtract(g[:, :k], g[:, k:], out=g[:, :k]), n)
+    d = np.empty(k)
+    for lo in range(0, k, SWEEP_CHUNK):
+        part = slice(lo, lo + SWEEP_CHUNK)
+        a, b, out = ea[part], eb[part], d[part]
+        np.multiply(n[0, part], x[0].take(a) - x[0].take(b), out=out)
+        out += n[1, part] * (x[1].take(a) - x[1].take(b))
+        out += n[2, part] * (x[2].take(a) - x[2].take(b))
+    return d
 
 
 def _separate_by_colour(c: ContactPoints, rows: ContactRows, pos: np.ndarray) -> None:

@@ -118,7 +118,8 @@ def hold_apart(f: SoftFrame, state: State, warm: WarmStart, s: np.ndarray) -> No
     end (``s``, each contact's separation then), up to the overlap each contact's load needs,
     s_eq = P·(1/m_a + 1/m_b)·(impulse scale)/((mass scale)·(bias rate))."""
     f.x[:, f.live] = state.body[f.idx, X].T
+    f.moved()
     s_end = f.separation(f.dt)
     s_eq = f.normal * f.whole * f.soft("impulse_scale") / (f.soft("mass_scale") * f.soft("bias_rate"))
     held = np.minimum(f.apart + np.maximum(s_end - s, 0.0), s_eq + s_end)
-    warm.keep_apart(f.keys(), np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0))
+    warm.keep_apart(np.where(s_end < 0.0, np.maximum(held, 0.0), 0.0), f.kept_order)

@@ -42,7 +42,7 @@ class SoftFrame:
         self.h = h = dt / substeps
         n_balls = model.spheres.count
         self.rows = contact_rows(model, state, c)
-        k = self.k = jacobi.ContactColumns(self.rows)
+        k = self.k = jacobi.ContactColumns(self.rows, split=False)  # each substep's solve splits
         self.rows.forget_radii()  # the solve reads the arms' lengths (``k.ra``, ``k.rb``) alone
         body = state.body
         self.k_balls = k.balls
@@ -75,20 +75,30 @@ class SoftFrame:
         # substeps (24 bytes a contact each)
         keys = c.keys()
         self.tangential = np.zeros((2, 3, kc))
-        self.normal = warm.impulses(keys, c.normal, h, self.tangential).normal
-        self.apart = warm.apart_of(keys)
+        at = warm.lookup(keys)
+        self.normal = warm.impulses(keys, c.normal, h, self.tangential, at).normal
+        self.apart = warm.apart_of(keys, at)
+        del at
         self.total = np.zeros(kc)
         self.least = c.gap.copy()
         self.farthest, self.largest = np.zeros(m), np.zeros(m)
         self.lo, self.hi = x[:, live].copy(), x[:, live].copy()
+        self._kept: tuple[float, np.ndarray] | None = None  # a separation kept for its next reader
+        self.kept_order: np.ndarray | None = None  # how the warm start sorted the pairs (store_impulses)
 
     def sweeps(
-        self, target: np.ndarray, count: int, m_n: np.ndarray | None = None, give: np.ndarray | None = None
+        self,
+        target: np.ndarray,
+        count: int,
+        m_n: np.ndarray | None = None,
+        give: np.ndarray | None = None,
+        speeds: list[np.ndarray] | None = None,
     ) -> None:
         """``count`` Jacobi sweeps of the soft normal update towards ``target`` (``jacobi.sweeps``,
-        friction and rolling in the last), from the frame's impulses to its new ones. The sweeps take
-        the old impulses as scratch, and the frame lets go of them first, so that the old normal
-        impulses go after the first sweep instead of being held through the rest (K floats)."""
+        friction and rolling in the last), from the frame's impulses to its new ones; ``speeds``, if given,
+        holds the contacts' normal speeds now (the first sweep's: taken and used up). The sweeps take the old
+        impulses as scratch, and the frame lets go of them first, so that the old normal impulses go
+        after the first sweep instead of being held through the rest (K floats)."""
         self.normal, self.tangential = jacobi.sweeps(
             self.k,
             self.vw,
@@ -99,6 +109,7 @@ class SoftFrame:
             friction_every=count,
             m_n=m_n,
             give=give,
+            speeds=speeds,
         )
 
     def _handed_over(self) -> np.ndarray:
@@ -126,9 +137,27 @@ class SoftFrame:
         """Each contact's soft coefficient ``name`` (a ``Softness`` field), made when used (K floats)."""
         return np.where(self.on_plane, getattr(self.plane_soft, name), getattr(self.ball_soft, name))
 
-    def separation(self, t: float) -> np.ndarray:
+    def separation(self, t: float, keep: bool = False) -> np.ndarray:
         """s = s₀ + n·(Δx_a − Δx_b): each contact's separation from the balls' moved positions (and a
-        moving plane's surface, moved by its speed along n for ``t``)."""
+        moving plane's surface, moved by its speed along n for ``t``). Read-only for its callers.
+
+        With ``keep`` it is kept for the next call at the same ``t`` (which takes it, instead of forming
+        it again) until the balls move (``moved``): a substep's relax and the next substep's solve (or
+        the frame's moving apart) read the separation at the same positions."""
+        kept, self._kept = self._kept, None
+        if kept is not None and kept[0] == t:
+            return kept[1]
+        s = self._separation(t)
+        if keep:
+            self._kept = (t, s)
+        return s
+
+    def moved(self) -> None:
+        """The balls' positions ``x`` changed: a kept separation no longer holds."""
+        self._kept = None
+
+    def _separation(self, t: float) -> np.ndarray:
+        """``separation``, formed."""
         d = self.x - self.x0
         k = len(self.ends_a)
         if k <= SWEEP_CHUNK:  # both ends gathered at once, their difference and its sums in place

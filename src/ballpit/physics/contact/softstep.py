@@ -147,9 +147,10 @@ def solve(f: SoftFrame, i: int) -> None:
     gap."""
     k, vw, h = f.k, f.vw, f.h
     s = f.separation(i * h)
-    # s + PUSH_AHEAD·min(v_n, 0)·h < 0, formed in v_n's array
-    ahead = k.normal_speeds(vw)
-    np.minimum(ahead, 0.0, out=ahead)
+    # s + PUSH_AHEAD·min(v_n, 0)·h < 0; v_n is also the first sweep's (the velocities are the same
+    # then), handed over in a list that the sweeps empty, so that no frame holds it after that sweep
+    speeds = [k.normal_speeds(vw)]
+    ahead = np.minimum(speeds[0], 0.0)
     ahead *= PUSH_AHEAD
     ahead *= h
     np.add(s, ahead, out=ahead)
@@ -176,7 +177,7 @@ def solve(f: SoftFrame, i: int) -> None:
     del speculative
     give *= k.m_n
     give *= k.whole
-    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give)
+    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give, speeds=speeds)
 
 
 def integrate_positions(f: SoftFrame) -> None:
@@ -186,6 +187,7 @@ def integrate_positions(f: SoftFrame) -> None:
     x = f.x[:, live]
     before = x.copy()
     x += f.vw[:3, live] * f.h
+    f.moved()
     quaternion.turn(f.q, f.vw[3:, live], f.h)
     moved = np.subtract(x, before, out=before)  # its squares then formed in place (norm_cols)
     length = np.empty(x.shape[1])
@@ -199,7 +201,7 @@ def integrate_positions(f: SoftFrame) -> None:
 def relax(f: SoftFrame, i: int) -> None:
     """Solve again without the bias, so the push-out moves positions but leaves no velocity; the least
     separation seen, and the substep's impulses added to the frame's."""
-    s = f.separation((i + 1) * f.h)
+    s = f.separation((i + 1) * f.h, keep=True)  # the next substep's solve (or moving apart) reads it too
     np.minimum(f.least, s, out=f.least)
     target = np.empty(len(s))
     target.fill(0.0)
@@ -273,6 +275,6 @@ def store_impulses(
     body[idx, Q] = f.q
     tangential = f.tangential
     f.vw = f.q = f.tangential = None
-    warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    f.kept_order = warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
     # what moving apart reads of the rows: the bodies, the inverse masses and the planes' surfaces
     f.rows = replace(f.rows, **dict.fromkeys(_ROWS_DONE))

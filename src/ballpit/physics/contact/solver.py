@@ -130,10 +130,18 @@ def solve(
     normal = [imp.normal[c.idx] for c in colours]
     friction = [np.ascontiguousarray(imp.friction[c.idx].T) for c in colours]
     rolling = [np.ascontiguousarray(imp.rolling[c.idx].T) for c in colours]
+    # with no friction and no rolling resistance anywhere no sweep turns a ball: each colour's n × lever
+    # is the same in every sweep, formed once (``_sweep_smooth``)
+    smooth = not any(c.has_friction or c.has_rolling for c in colours)
+    turns = [_spin_turn(c, vw) for c in colours] if smooth else None
     for _ in range(iterations):
         change = 0.0  # a bound on the largest velocity change this sweep made at any contact (m/s)
         for k, c in enumerate(colours):
-            change = max(change, _sweep_colour(c, vw, targets[k], normal, friction, rolling, k))
+            if turns is not None:
+                found = _sweep_smooth(c, vw, turns[k], targets[k], normal, k)
+            else:
+                found = _sweep_colour(c, vw, targets[k], normal, friction, rolling, k)
+            change = max(change, found)
         if change < CONVERGED:
             break
     v[ends.balls] = vw[:3].T
@@ -147,6 +155,45 @@ def solve(
     return imp
 
 
+def _spin_turn(c: _Colour, vw: np.ndarray) -> np.ndarray:
+    """n × (ρ_a·ω_a + ρ_b·ω_b) of the colour ``c``: what the balls' spins add to its contact-point
+    velocities (``contact_model.contact_velocity``), by the same operations."""
+    w = vw[3:]
+    return exact.cross_cols(c.n, model.spin_lever(w.take(c.a, axis=1), w.take(c.b, axis=1), c.ra, c.rb))
+
+
+def _sweep_smooth(
+    c: _Colour, vw: np.ndarray, turn: np.ndarray, target: np.ndarray, normal: list, k: int
+) -> float:
+    """``_sweep_colour`` of a solve with no friction and no rolling resistance: the normal impulse
+    alone, which never turns a ball, so the spins' ``turn`` (``_spin_turn``) is formed once a solve.
+    The same operations on the velocities as ``_sweep_colour``'s, and the same bound returned."""
+    v = vw[:3]
+    va, vb = v.take(c.a, axis=1), v.take(c.b, axis=1)
+    rel = va - vb  # model.point_velocity with n × lever given
+    rel += turn
+    if c.surface is not None:
+        rel -= c.surface
+    d_n, linear = _normal_update(c, exact.dot_cols_in_place(rel, c.n), target, normal, k)
+    va += c.ima * linear
+    vb -= c.imb * linear
+    v[:, c.a] = va
+    v[:, c.b] = vb
+    return float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
+
+
+def _normal_update(
+    c: _Colour, vn: np.ndarray, target: np.ndarray, normal: list, k: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The colour's new normal impulses from its normal speeds ``vn``, into ``normal[k]``; returns
+    their change d_n and the linear impulse d_n·n it adds."""
+    old = normal[k]
+    new = model.normal_impulse(old, c.m_n, target, vn)
+    normal[k] = new
+    d_n = new - old
+    return d_n, d_n * c.n
+
+
 def _sweep_colour(
     c: _Colour, vw: np.ndarray, target: np.ndarray, normal: list, friction: list, rolling: list, k: int
 ) -> float:
@@ -157,12 +204,8 @@ def _sweep_colour(
     va, wa, vb, wb = ga[:3], ga[3:], gb[:3], gb[3:]
     rel = model.contact_velocity(va, wa, vb, wb, c.n, c.ra, c.rb, c.surface)
     vn = exact.dot_cols(rel, c.n)
-
-    old = normal[k]
-    new = model.normal_impulse(old, c.m_n, target, vn)
-    normal[k] = new
-    d_n = new - old
-    linear = d_n * c.n
+    d_n, linear = _normal_update(c, vn, target, normal, k)
+    new = normal[k]
     change = float(np.maximum.reduce(np.abs(d_n), axis=None)) * c.max_inv_m_n
 
     if c.has_friction and c.has_rolling:

@@ -32,6 +32,11 @@ class WarmStart:
         """Put back the warm start ``saved`` (a ``checkpoint``; it stays usable)."""
         self.__dict__.update(vars(saved))
 
+    def lookup(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """Which of the pairs ``keys`` are kept, and where, as ``impulses`` and ``apart_of`` look them
+        up (a caller asking both for the same pairs looks them up once); None when nothing is kept."""
+        return self._found(keys) if len(self.keys) else None
+
     def _found(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Which of the pairs ``keys`` are kept, and where (the kept rows of those found)."""
         pos = np.searchsorted(self.keys, keys)
@@ -48,18 +53,23 @@ class WarmStart:
         return normal
 
     def impulses(
-        self, keys: np.ndarray, normal: np.ndarray, h: float, tangential: np.ndarray | None = None
+        self,
+        keys: np.ndarray,
+        normal: np.ndarray,
+        h: float,
+        tangential: np.ndarray | None = None,
+        at: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> Impulses:
         """The kept forces of the pairs ``keys`` still touching, as impulses over ``h``; the friction
         and rolling impulses into ``tangential`` when given (zeros, (2, 3, K): ``jacobi.sweeps``' block)
-        as views of its rows, with no (K, 3) arrays of their own."""
+        as views of its rows, with no (K, 3) arrays of their own. ``at``: ``lookup(keys)``, if made."""
         if tangential is None:
             imp = Impulses.zeros(len(keys))
         else:
             imp = Impulses(np.zeros(len(keys)), tangential[0].T, tangential[1].T)
         if len(self.keys) == 0:
             return imp
-        found, src = self._found(keys)
+        found, src = self._found(keys) if at is None else at
         imp.normal[found] = self.forces.normal[src] * h
         if len(src) <= SWEEP_CHUNK:
             imp.friction[found] = _on_tangent_plane(self.forces.friction[src] * h, normal[found])
@@ -72,13 +82,15 @@ class WarmStart:
             imp.rolling[to] = self.forces.rolling[at] * h
         return imp
 
-    def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> None:
-        """Remember the impulses found over ``h`` as forces, for the next solve."""
+    def keep(self, keys: np.ndarray, imp: Impulses, h: float) -> np.ndarray:
+        """Remember the impulses found over ``h`` as forces, for the next solve; returns the order the
+        pairs ``keys`` are kept in (for ``keep_apart``)."""
         order = np.argsort(keys)
         self.keys = keys[order]
         parts = (imp.normal, imp.friction, imp.rolling)
         self.forces = Impulses(*(_divided(part[order], h) for part in parts))
         self.apart = np.zeros(len(keys))
+        return order
 
     def put_to_sleep(self, asleep: np.ndarray) -> None:
         """Put aside the kept forces of the pairs whose balls are all ``asleep`` (a plane counts as
@@ -105,18 +117,20 @@ class WarmStart:
         self.keys, self.forces, self.apart = merged
         self.asleep = _rows(self.asleep, still)
 
-    def apart_of(self, keys: np.ndarray) -> np.ndarray:
-        """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept)."""
+    def apart_of(self, keys: np.ndarray, at: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+        """How far the soft springs of the pairs ``keys`` hold them apart (0 for pairs not kept);
+        ``at``: ``lookup(keys)``, if made."""
         held = np.zeros(len(keys))
         if len(self.keys) == 0:
             return held
-        found, src = self._found(keys)
+        found, src = self._found(keys) if at is None else at
         held[found] = self.apart[src]
         return held
 
-    def keep_apart(self, keys: np.ndarray, apart: np.ndarray) -> None:
-        """Remember ``apart`` for the pairs ``keys``, the ones just kept by ``keep``."""
-        self.apart = apart[np.argsort(keys)]
+    def keep_apart(self, apart: np.ndarray, order: np.ndarray) -> None:
+        """Remember ``apart`` for the pairs just kept by ``keep``, given as they were given to it;
+        ``order`` is the order it returned (the pairs are not sorted again)."""
+        self.apart = apart[order]
 
 
 def _on_tangent_plane(friction: np.ndarray, n: np.ndarray) -> np.ndarray:

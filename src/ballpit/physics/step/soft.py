@@ -195,7 +195,7 @@ def verdict(
         free, _ = free_acceleration(state.body, motion.forces)
         pairs = step.pairs.renew(model, state, step.dt, BROAD_PHASE_STEPS * step.dt, free, free, motion.awake)
         now = narrowphase.contact_points(model, state, pairs)
-        out = now.subset(~np.isin(now.keys(), c.keys()))
+        out = now.subset(~_among(now.keys(), c.keys()))
         out.gap = _gap_from(out, before, model, state)
     else:
         out = left
@@ -213,6 +213,15 @@ def verdict(
     if (out.gap < -DEEP_OVERLAP * smaller).any():
         return Verdict.LEFT_OUT
     return Verdict.KEPT
+
+
+def _among(keys: np.ndarray, of: np.ndarray) -> np.ndarray:
+    """Which of ``keys`` are among the distinct pair keys ``of`` (``np.isin``, which sorts both
+    together): ``of`` sorted alone and each key found in it by binary search, at half the cost."""
+    if len(of) == 0:
+        return np.zeros(len(keys), bool)
+    sorted_of = np.sort(of)
+    return sorted_of[np.minimum(np.searchsorted(sorted_of, keys), len(of) - 1)] == keys
 
 
 def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) -> np.ndarray:
