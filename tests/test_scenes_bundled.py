@@ -202,6 +202,7 @@ def test_cannon_throws_its_top_ball_far_above_where_it_was_dropped_from(tmp_path
     assert top > 4 * start
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_seesaw_rolls_the_balls_down_then_tips_them_off_its_far_end(tmp_path):
     """The see-saw demo, judged from ``ballpit simulate`` output: the balls land on the plank, roll
     left (downhill), turn back as it tips over, and leave its right end for the floor."""

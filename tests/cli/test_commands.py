@@ -448,6 +448,7 @@ def test_a_background_run_is_killed_when_its_test_fails_or_times_out():
     assert proc.returncode == -signal.SIGKILL
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 @pytest.mark.skipif(sys.platform != "linux", reason="PR_SET_PDEATHSIG is Linux's")
 def test_a_background_run_dies_with_a_test_process_that_is_killed_outright(tmp_path):
     """As when a time limit kills pytest itself: no ``finally`` runs, and still nothing is left."""
@@ -604,6 +605,7 @@ def without_matplotlib(*args: str | Path, timeout: float = 120) -> subprocess.Co
     )  # fmt: skip
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_without_matplotlib_the_viewers_commands_run_and_plot_options_say_what_to_install(tmp_path):
     # what the viewer and the headless runner need works without it
     r = without_matplotlib("simulate", "scenes/slopes.toml", "--duration", "0.1", "--out", tmp_path / "t.csv")

@@ -50,6 +50,7 @@ def test_resting_contacts_are_written_every_step_after_the_balls_fall_asleep(tmp
     assert last[("sphere-plane", 1)] == pytest.approx((2.0 + 0.75) * 9.81 * DT, rel=1e-4)
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_the_summary_counts_only_the_contacts_the_steps_solved(tmp_path):
     """Sleeping balls' rows are added to the events file only; the run's contact counts stay the step's."""
     world = _resting_pair()

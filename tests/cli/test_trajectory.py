@@ -137,6 +137,7 @@ def test_a_bomb_that_understates_its_size_is_refused_unread(tmp_path, capsys):
     assert "claims shape (1048576,) but holds 200 bytes" in err or "Bad CRC-32" in err
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_a_kernel_file_whose_reads_block_is_refused_by_every_command():
     """/proc/kmsg is a 'regular' file to stat whose reads wait for kernel messages; read by root it
     hung check, simulate, compare and view. Without root it is 'permission denied'; either way, no wait."""

@@ -158,6 +158,7 @@ def test_a_file_name_over_255_bytes(tmp_path):
     refused(tmp_path / ("x" * 300 + ".toml"), "File name too long")
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_a_fifo_is_refused_without_blocking(tmp_path):
     fifo = tmp_path / "pipe.toml"
     os.mkfifo(fifo)

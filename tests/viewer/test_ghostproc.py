@@ -61,6 +61,7 @@ def assert_same_ghosts(here: Simulation, apart: Simulation) -> None:
         assert np.array_equal(a[key], b[key], equal_nan=True), key
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_ghosts_in_their_own_process_follow_the_run_through_steps_back_and_resumes_bit_for_bit():
     here, apart = pair()
     try:
@@ -82,6 +83,7 @@ def test_ghosts_in_their_own_process_follow_the_run_through_steps_back_and_resum
         apart.close()
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_edits_resets_and_integrator_switches_reach_the_ghosts_in_the_same_process():
     here, apart = pair()
     try:
@@ -211,6 +213,7 @@ def test_closing_never_waits_for_the_ghosts_process_in_the_middle_of_its_steps()
     assert gone(pid)
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_after_a_move_back_in_time_the_child_steps_ahead_of_that_step_not_of_the_old_present():
     from ballpit.viewer.ghostproc import AHEAD
 

@@ -33,6 +33,7 @@ def test_a_shot_ball_grows_everything_kept_per_ball_and_reset_drops_it_again():
     )
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_a_shot_ball_is_made_of_the_scenes_material_and_rolls_to_a_stop_at_five_sevenths_rho_g():
     sim = Simulation(read_scene(REPO / "scenes" / "slopes.toml"))  # every ball: e 1, mu 0.5, rho 0.3
     camera = Camera.looking_at((0.0, 0.25, 3.0), (0.0, 0.25, 10.0))  # eye at a ball's height, level

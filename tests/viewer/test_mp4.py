@@ -146,6 +146,7 @@ WITHOUT_AV = (
 )
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_without_pyav_render_to_mp4_says_which_extra_to_install_and_gif_still_works(tmp_path):
     def run(*args: object) -> subprocess.CompletedProcess:
         return subprocess.run([sys.executable, "-c", WITHOUT_AV, *map(str, args)], capture_output=True,

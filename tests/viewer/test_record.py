@@ -191,6 +191,7 @@ def test_the_close_button_writes_the_record_and_a_reset_starts_the_timeline_agai
     assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_a_bad_record_path_is_a_one_line_error_before_any_window(tmp_path):
     for bad, says in (("run.txt", "must end in .csv or .npz"), ("nowhere/run.npz", "does not exist")):
         proc = subprocess.run(

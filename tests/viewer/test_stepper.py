@@ -68,6 +68,7 @@ def test_commands_sent_while_it_runs_free_are_applied_between_steps_and_answered
     assert answers == [(k, threading.get_ident()) for k in range(20)]  # in order, back on this thread
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_the_real_time_factor_is_what_slow_steps_manage_not_the_time_scale():
     """Each step made to take 20 ms of wall time: at most 50 steps of 1/240 s a second, a real-time
     factor of at most 50/240 = 0.21, whatever is asked."""
@@ -110,6 +111,7 @@ def test_steps_slower_than_real_time_follow_each_other_without_a_pause():
     assert busy > 0.9  # what the window reads to draw less (pacing.py)
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_the_busy_share_is_near_zero_while_nothing_steps_and_near_one_while_steps_run_late():
     world = line_of_balls(3)
     sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))

@@ -252,6 +252,7 @@ def test_plus_and_minus_typed_on_a_real_keyboard_change_the_time_scale_every_tim
     assert r["scales"] == [2.0, 4.0, 8.0, 4.0, 2.0, 4.0, 2.0, 1.0]
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_without_a_display_the_viewer_prints_one_line_and_exits_1(tmp_path):
     code = "import sys; from ballpit.viewer.app import run; sys.exit(run())"
     for display in (None, ":12345"):  # no DISPLAY at all; a DISPLAY with no server behind it

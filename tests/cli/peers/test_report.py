@@ -144,6 +144,7 @@ def test_each_peer_names_its_fastest_stable_settings():
     assert ENGINES["pybullet"].settings().describe().startswith("rigid bodies (useMaximalCoordinates=True)")
 
 
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
 def test_the_plot_has_the_sizes_run_on_its_x_axes_and_plain_numbers_for_the_rates():
     summaries = [
         report.Summary(engine, n, [rate * 1000 / n], 0.2, 0.01, n, 0.25)
