@@ -136,14 +136,14 @@ def spin_lever(
 
 def point_velocity(
     dv: np.ndarray,
-    lever: np.ndarray,
+    lever: np.ndarray | None,
     n: np.ndarray,
     surface: np.ndarray | None = None,
     turn: np.ndarray | None = None,
 ) -> np.ndarray:
     """``contact_velocity`` from the relative velocity ``dv`` = v_a − v_b (changed in place and
     returned) and the ``spin_lever``: dv + n × lever − surface (n × lever given as ``turn`` if it was
-    formed already)."""
+    formed already; ``lever`` is then not read)."""
     dv += exact.cross_cols(n, lever) if turn is None else turn
     if surface is not None:
         dv -= surface

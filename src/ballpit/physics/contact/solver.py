@@ -170,10 +170,7 @@ def _sweep_smooth(
     The same operations on the velocities as ``_sweep_colour``'s, and the same bound returned."""
     v = vw[:3]
     va, vb = v.take(c.a, axis=1), v.take(c.b, axis=1)
-    rel = va - vb  # model.point_velocity with n × lever given
-    rel += turn
-    if c.surface is not None:
-        rel -= c.surface
+    rel = model.point_velocity(va - vb, None, c.n, c.surface, turn)
     d_n, linear = _normal_update(c, exact.dot_cols_in_place(rel, c.n), target, normal, k)
     va += c.ima * linear
     vb -= c.imb * linear
