@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import exact
+from ..core.contacts import find_keys
 from ..core.settings import SWEEP_CHUNK
 from ..core.state import shallow_copy
 from .contact_model import Impulses
@@ -39,9 +40,7 @@ class WarmStart:
 
     def _found(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Which of the pairs ``keys`` are kept, and where (the kept rows of those found)."""
-        pos = np.searchsorted(self.keys, keys)
-        pos = np.minimum(pos, len(self.keys) - 1)
-        found = self.keys[pos] == keys
+        found, pos = find_keys(self.keys, keys)
         return found, pos[found]
 
     def normal_impulses(self, keys: np.ndarray, h: float) -> np.ndarray:
