@@ -12,8 +12,8 @@ PYTEST_ARGS ?=  # more for pytest: make test PYTEST_ARGS=--durations=20
 
 # The installs go through uv (from PyPI, into the venv): it links the wheels from its cache instead of
 # unpacking them, and compiles no bytecode (Python compiles the modules the run imports when it first
-# does). From a clone, with the caches warm: the test install 10 s instead of pip's 27 (its 330 MB of
-# PyBullet data alone took pip several seconds). Where uv cannot be had, pip does the same install.
+# does). From a clone, with the caches warm: the test install 10 s instead of pip's 19-27 (its 330 MB
+# of PyBullet data alone took pip several seconds). Where uv cannot be had, pip does the same install.
 INSTALL = $(PY) -m pip install --quiet uv && $(VENV)/bin/uv pip install --quiet --python $(PY) -e
 PIP_INSTALL = $(PY) -m pip install --quiet --no-compile -e
 

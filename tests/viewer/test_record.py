@@ -18,10 +18,10 @@ from ballpit.cli.trajectory import TRAJECTORY_COLUMNS
 from ballpit.scene import default_scene_path, read_scene
 
 from .conftest import run_driver, subprocess_env
+from .test_reach import DRIVER as REACH_DRIVER
 
-# record_close_button runs on its own: asked through test_reach's batch, a worker without that batch ran
-# all of reach_driver.py's scenarios again for it
-REACH_DRIVER = Path(__file__).with_name("reach_driver.py")
+# record_close_button runs on its own (REACH_DRIVER): asked through test_reach's batch, a worker without
+# that batch ran all of reach_driver.py's scenarios again for it
 
 needs_xdotool = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
