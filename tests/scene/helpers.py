@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import io
 import warnings
 from contextlib import redirect_stderr, redirect_stdout
@@ -13,6 +14,9 @@ from ballpit import cli
 def run_cli(*args: str | Path) -> tuple[int, list[str]]:
     """Run the command line in this process: (exit status, stderr lines and any warnings)."""
     err, out = io.StringIO(), io.StringIO()
+    # objects earlier tests in this worker left to the collector (a subprocess's text pipes, "unclosed
+    # file") are collected now, so that their warnings are not taken for this command's
+    gc.collect()
     with redirect_stderr(err), redirect_stdout(out), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
