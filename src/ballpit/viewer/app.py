@@ -362,7 +362,8 @@ class Viewer:
         self.window.switch_to()
         width, height = self.window.get_framebuffer_size()
         view = self.view_target
-        drawn = view.begin(width, height)
+        covered = round(self.panel.width * width / max(self.window.width, 1))  # framebuffer pixels
+        drawn = view.begin(width, height, left=covered)
         key = self._view_key(shown, width, height)
         if not (view.keeps_image and key is not None and key == self._drawn_key):
             selected = self.interaction.selected_plane

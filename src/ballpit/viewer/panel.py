@@ -218,7 +218,7 @@ class Panel:
         h = self.viewer.window.height
         imgui.set_next_window_pos(ImVec2(0, 0))
         imgui.set_next_window_size(ImVec2(WIDTH, h))
-        imgui.set_next_window_bg_alpha(0.86)
+        imgui.set_next_window_bg_alpha(1.0)  # opaque: the view is not drawn under it
         flags = (
             imgui.WindowFlags_.no_move
             | imgui.WindowFlags_.no_resize
