@@ -27,8 +27,11 @@ class ContactColumns(Ends):
         caller that splits before its first sweep, as a soft frame's solve does, says False)."""
         super().__init__(contacts.a, contacts.b)
         k, m = self.k, self.m
-        self.ima, self.imb = contacts.inv_mass_a, contacts.inv_mass_b
-        self.iia, self.iib = contacts.inv_inertia_a, contacts.inv_inertia_b
+        ima, imb = contacts.inv_mass_a, contacts.inv_mass_b
+        iia, iib = contacts.inv_inertia_a, contacts.inv_inertia_b
+        # each contact's 1/m and 1/I at both ends, up to SWEEP_CHUNK contacts; beyond, gathered from
+        # each ball's (``inverse``) where a chunk needs them, not held (32 bytes a contact)
+        self._masses = (ima, imb, iia, iib) if k <= SWEEP_CHUNK else None
         self.ra, self.rb = contacts.arm_lengths()
         self.n = np.ascontiguousarray(contacts.normal.T)
         # the friction cone μ·P_n and the rolling limit ρ_roll·P_n, per unit of normal impulse (the rows'
@@ -36,14 +39,13 @@ class ContactColumns(Ends):
         self.friction, self.rolling = contacts.friction, contacts.rolling
         # each ball's own m⁻¹ and I⁻¹, for adding the summed impulses to its velocity
         inv_mass, inv_inertia = np.zeros(m), np.zeros(m)
-        inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = self.ima, self.imb
-        inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = self.iia, self.iib
+        inv_mass[self.ends[:k]], inv_mass[self.ends[k:]] = ima, imb
+        inv_inertia[self.ends[:k]], inv_inertia[self.ends[k:]] = iia, iib
         self.inverse = np.stack((inv_mass, inv_inertia))  # (2, M): m⁻¹ for v's rows, I⁻¹ for ω's
         # 1/m_n of the unsplit balls, and bounds on how much a unit of impulse changes a contact's
         # velocity, for the convergence test
-        inv_n, inv_t, _ = model.inverse_effective_masses(
-            self.ima, self.imb, self.iia, self.iib, self.ra, self.rb
-        )
+        inv_n, inv_t, _ = model.inverse_effective_masses(ima, imb, iia, iib, self.ra, self.rb)
+        del ima, imb, iia, iib
         self.whole = inv_n
         self.inv_m_n, self.inv_m_t = float(inv_n.max()), float(inv_t.max())
         self.moving = contacts.moving
@@ -59,6 +61,26 @@ class ContactColumns(Ends):
         self.m_tr: np.ndarray | None = None
         if split:
             self.split()
+
+    @property
+    def ima(self) -> np.ndarray:
+        """Each contact's a's 1/m (read only)."""
+        return self._masses[0] if self._masses is not None else self.inverse[0].take(self.ends[: self.k])
+
+    @property
+    def imb(self) -> np.ndarray:
+        """Each contact's b's 1/m, 0 for a plane (read only)."""
+        return self._masses[1] if self._masses is not None else self.inverse[0].take(self.ends[self.k :])
+
+    @property
+    def iia(self) -> np.ndarray:
+        """Each contact's a's 1/I (read only)."""
+        return self._masses[2] if self._masses is not None else self.inverse[1].take(self.ends[: self.k])
+
+    @property
+    def iib(self) -> np.ndarray:
+        """Each contact's b's 1/I, 0 for a plane (read only)."""
+        return self._masses[3] if self._masses is not None else self.inverse[1].take(self.ends[self.k :])
 
     def normal_speeds(self, v: np.ndarray) -> np.ndarray:
         """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it
@@ -103,12 +125,14 @@ class ContactColumns(Ends):
             return
         if self.m_n is None:
             self.m_n = np.empty(k)
+        # each ball's n_b·m⁻¹ and n_b·I⁻¹, gathered per contact end: the same products as a contact's
+        # share times its own m⁻¹ and I⁻¹
+        self.split_inverse = split = share * self.inverse
         for lo in range(0, k, SWEEP_CHUNK):
             part = slice(lo, min(lo + SWEEP_CHUNK, k))
-            sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
             # model.effective_masses' m_n: 1/(n_a·m_a⁻¹ + n_b·m_b⁻¹)
-            inv_n = sa * self.ima[part]
-            inv_n += sb * self.imb[part]
+            inv_n = split[0].take(self.ends[:k][part])
+            inv_n += split[0].take(self.ends[k:][part])
             np.divide(1.0, inv_n, out=self.m_n[part])
 
     def tangent_masses(self, part: slice) -> np.ndarray:
@@ -116,14 +140,14 @@ class ContactColumns(Ends):
         with the masses split as the last ``split`` split them (``model.effective_masses``)."""
         if self.k <= SWEEP_CHUNK:
             return self.m_tr
-        k, share = self.k, self.shares
-        sa, sb = share[self.ends[:k][part]], share[self.ends[k:][part]]
-        m_t_r = np.empty((2, 1, len(sa)))
+        k, split = self.k, self.split_inverse
+        ea, eb = self.ends[:k][part], self.ends[k:][part]
+        m_t_r = np.empty((2, 1, len(ea)))
         _, m_t_r[0, 0], m_t_r[1, 0] = model.effective_masses(
-            sa * self.ima[part],
-            sb * self.imb[part],
-            sa * self.iia[part],
-            sb * self.iib[part],
+            split[0].take(ea),
+            split[0].take(eb),
+            split[1].take(ea),
+            split[1].take(eb),
             self.ra[part],
             self.rb[part],
         )

@@ -30,6 +30,14 @@ class Ends:
         self.m = len(self.balls)
         self._flat: dict[int, np.ndarray] = {}  # add_up's bins for every entry, by number of rows
 
+    @classmethod
+    def numbered(cls, balls: np.ndarray, ends: np.ndarray) -> Ends:
+        """The ends of contacts numbered already (``balls`` and ``ends`` as another ``Ends`` of the same
+        contacts made them), without numbering them again."""
+        e = cls.__new__(cls)
+        e.k, e.balls, e.ends, e.m, e._flat = len(ends) // 2, balls, ends, len(balls), {}
+        return e
+
     @cached_property
     def share(self) -> np.ndarray:
         """Each ball's number of contacts, as a float (made when first asked: a Gauss–Seidel solve

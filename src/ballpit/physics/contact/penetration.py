@@ -54,10 +54,11 @@ def separate(
     b: np.ndarray,
     normal: np.ndarray,
     gap: np.ndarray,
-    inv_mass_a: np.ndarray,
-    inv_mass_b: np.ndarray,
+    inv_mass_a: np.ndarray | None,
+    inv_mass_b: np.ndarray | None,
     pos: np.ndarray,
     sweeps: int,
+    columns: tuple[Ends, np.ndarray] | None = None,
 ) -> None:
     """Move overlapping balls apart along their normals, all contacts at once per sweep: each
     contact's overlap (−``gap`` at the start, along the fixed normal) is shared between its balls in
@@ -66,11 +67,22 @@ def separate(
     Up to SWEEP_CHUNK contacts a sweep works on (3, K) and (3, 2K) blocks, one gather and one
     ``add_up`` each; beyond, one coordinate at a time, on (K,) and (2K,) rows: the same operations in
     the same order (v_n as ``exact.dot_cols`` sums it, each row added up as ``add_up`` does), without
-    the blocks' memory."""
-    e = Ends(a, b)
+    the blocks' memory.
+
+    ``columns``, if given, are the contacts' ends as another solve numbered them and each ball's 1/m in
+    that numbering, read instead of numbering the ends again and of ``inv_mass_a`` and ``inv_mass_b``
+    (the same values: a contact's 1/m is its ball's)."""
+    e = Ends(a, b) if columns is None else columns[0]
     k, balls, ends, share = e.k, e.balls, e.ends, e.share
     ea, eb = ends[:k], ends[k:]
-    fa, fb = contact_model.separation_parts(share[ea] * inv_mass_a, share[eb] * inv_mass_b)  # each end's part
+    if columns is None:
+        split_a, split_b = share[ea] * inv_mass_a, share[eb] * inv_mass_b
+    else:  # each ball's n_b·m⁻¹ gathered per end: the same products
+        split = share * columns[1]
+        split_a, split_b = split.take(ea), split.take(eb)
+        del split
+    fa, fb = contact_model.separation_parts(split_a, split_b)  # each end's part
+    del split_a, split_b
     n = np.ascontiguousarray(normal.T)
     x = np.ascontiguousarray(pos[balls].T)  # (3, M)
     start = _along(e, n, x).copy()  # (not the view of its gather's block)

@@ -36,10 +36,10 @@ class ContactRows:
     # the lever arms (centre → contact point) are r_a = −radius_a·n and r_b = radius_b·n (``arm_lengths``)
     radius_a: np.ndarray | None  # (K,) a's radius (None once the arms are made, ``forget_radii``)
     radius_b: np.ndarray | None  # (K,) b's radius, zero for planes
-    inv_mass_a: np.ndarray
-    inv_mass_b: np.ndarray
-    inv_inertia_a: np.ndarray
-    inv_inertia_b: np.ndarray
+    inv_mass_a: np.ndarray | None  # (None while let go of, ``forget_masses``)
+    inv_mass_b: np.ndarray | None
+    inv_inertia_a: np.ndarray | None
+    inv_inertia_b: np.ndarray | None
     restitution: np.ndarray
     friction: np.ndarray
     rolling: np.ndarray  # rolling resistance ρ·r (m): angular impulse per unit normal impulse
@@ -49,6 +49,9 @@ class ContactRows:
     static: int  # the static world's row (the number of balls)
     # |r_a| and |r_b| kept once the radii are let go (``forget_radii``); None: made from the radii
     arms: tuple[np.ndarray, np.ndarray] | None = None
+    # each body's 1/m and 1/I (N + 1 rows, the static world's last), as the four columns above were
+    # gathered from, for ``recall_masses``
+    body_inverse: tuple[np.ndarray, np.ndarray] | None = None
 
     def __len__(self) -> int:
         return len(self.a)
@@ -85,20 +88,36 @@ class ContactRows:
 
     def subset(self, mask: np.ndarray) -> ContactRows:
         """The contacts where ``mask`` holds."""
-        kept = ("moving", "static")
+        kept = ("moving", "static", "body_inverse")
         idx = take_indices(mask)
         found = (*kept, "colours", "_arms", "arms")  # worked out from the rows, not rows themselves
         fields = {
             k: None if v is None else v.take(idx, axis=0) for k, v in vars(self).items() if k not in found
         }
         arms = None if self.arms is None else (self.arms[0].take(idx), self.arms[1].take(idx))
-        return ContactRows(**fields, moving=self.moving, static=self.static, arms=arms)
+        return ContactRows(
+            **fields, moving=self.moving, static=self.static, arms=arms, body_inverse=self.body_inverse
+        )
 
     def forget_radii(self) -> None:
         """Keep the lever arms' lengths (``arm_lengths``) and let go of the radii they are made of:
         16 bytes a contact. Subsets and copies keep the lengths of their rows."""
         self.arms = self._arms
         self.radius_a = self.radius_b = None
+
+    def forget_masses(self) -> None:
+        """Let go of the contacts' inverse masses and inertias (32 bytes a contact), for a solve that
+        reads them per ball (``ContactColumns.inverse``); ``recall_masses`` gathers them again."""
+        self.inv_mass_a = self.inv_mass_b = self.inv_inertia_a = self.inv_inertia_b = None
+
+    def recall_masses(self) -> None:
+        """The inverse masses and inertias ``forget_masses`` let go of, gathered again from the bodies'
+        (the same values)."""
+        if self.inv_mass_a is not None:
+            return
+        inv_mass, inv_inertia = self.body_inverse
+        self.inv_mass_a, self.inv_mass_b = inv_mass[self.a], inv_mass[self.b]
+        self.inv_inertia_a, self.inv_inertia_b = inv_inertia[self.a], inv_inertia[self.b]
 
 
 def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
@@ -146,6 +165,7 @@ def contact_rows(model: Model, state: State, c: ContactPoints) -> ContactRows:
         spin=spin,
         moving=moving,
         static=sph.count,
+        body_inverse=(inv_mass, inv_inertia),
     )
 
 

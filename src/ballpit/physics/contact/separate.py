@@ -29,6 +29,7 @@ from ..core.settings import (
 from ..core.state import State, X, with_static
 from ..dynamics.model import Model
 from . import energy_guard, penetration
+from .ends import Ends
 from .soft_frame import SoftFrame
 from .warm_start import WarmStart
 
@@ -52,23 +53,23 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
     del slop
     part = np.flatnonzero(made < -SEPARATE_REACH * made.min())
     pos = with_static(body[:, X])
-    # the contacts ``part``; every contact (a settled pile) as the frame holds them, not copies
+    # the contacts ``part``; every contact (a settled pile) as the frame holds them, not copies, and
+    # numbered as the frame's solve numbered their balls, with each ball's 1/m
     every = len(part) == len(made)
     if every:
         del part
+        columns = Ends.numbered(f.k_balls, f.k_ends), f.ball_inverse_mass()
+        inv_mass_a = inv_mass_b = None
+    else:
+        rows.recall_masses()
+        columns, inv_mass_a, inv_mass_b = None, rows.inv_mass_a[part], rows.inv_mass_b[part]
     take = (lambda a: a) if every else (lambda a: a[part])
     # the normals laid out as (3, K) columns, as separate reads them (``c.normal`` is)
     normals = c.normal if every else np.take(c.normal.T, part, axis=1).T
     penetration.separate(
-        take(c.a),
-        take(c.b),
-        normals,
-        take(made),
-        take(rows.inv_mass_a),
-        take(rows.inv_mass_b),
-        pos,
-        SEPARATE_SWEEPS,
+        take(c.a), take(c.b), normals, take(made), inv_mass_a, inv_mass_b, pos, SEPARATE_SWEEPS, columns
     )
+    del columns
     del normals, made
     new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
     energy_guard.pay_for_lift(model, state, body[:, X], new)

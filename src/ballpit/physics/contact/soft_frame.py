@@ -44,6 +44,8 @@ class SoftFrame:
         self.rows = contact_rows(model, state, c)
         k = self.k = jacobi.ContactColumns(self.rows, split=False)  # each substep's solve splits
         self.rows.forget_radii()  # the solve reads the arms' lengths (``k.ra``, ``k.rb``) alone
+        if len(c) > SWEEP_CHUNK:  # and each ball's inverse mass and inertia (``k.inverse``)
+            self.rows.forget_masses()
         body = state.body
         self.k_balls = k.balls
         m_dyn = int(np.searchsorted(k.balls, n_balls))  # the static row N, if there, is the last column
@@ -85,6 +87,10 @@ class SoftFrame:
         self.lo, self.hi = x[:, live].copy(), x[:, live].copy()
         self._kept: tuple[float, np.ndarray] | None = None  # a separation kept for its next reader
         self.kept_order: np.ndarray | None = None  # how the warm start sorted the pairs (store_impulses)
+        # what moving apart reads of the solve once it has let go of it (store_impulses): each contact's
+        # unsplit 1/m_n and each ball's 1/m
+        self.whole: np.ndarray | None = None
+        self.inv_mass: np.ndarray | None = None
 
     def sweeps(
         self,
@@ -116,6 +122,10 @@ class SoftFrame:
         """The normal impulses, no longer held by the frame."""
         normal, self.normal = self.normal, None
         return normal
+
+    def ball_inverse_mass(self) -> np.ndarray:
+        """Each ball's 1/m, by the solve's columns (``k.inverse``, or kept once it let go of them)."""
+        return self.inv_mass if self.inv_mass is not None else self.k.inverse[0]
 
     def keys(self) -> np.ndarray:
         """The pairs' keys (``ContactPoints.keys``)."""

@@ -227,6 +227,7 @@ def restitution(f: SoftFrame, model: Model, state: State, threshold: float) -> n
     added = np.zeros(len(normal))
     vn_start = f.start_speeds(state)
     if (pressed & (vn_start < -threshold) & (rows.restitution > 0.0)).any():
+        rows.recall_masses()  # the waves' Gauss–Seidel solves read them per contact
         after, struck = impacts.waves_from(model, rows, k, f.vw, vn_start, threshold, pressed)
         # the pressed contacts beside a struck one take part too: a ball the waves left still holds on them
         touched = np.zeros(k.m, bool)
@@ -265,6 +266,7 @@ def store_impulses(
     # what follows needs of the solve only each contact's 1/m_n: its columns and scratch go now, before
     # the undo copies the balls and the warm start makes its own sorted copies of the impulses
     f.whole = f.k.whole
+    f.inv_mass = f.k.inverse[0].copy()  # each ball's 1/m, as moving apart reads it
     f.k = None
     if before_write is not None:
         before_write()
