@@ -11,9 +11,10 @@ from enum import Enum
 import numpy as np
 
 from ..collision import geometry, narrowphase
+from ..collision.pairs import KeptPairs
 from ..contact import energy_guard, softstep
 from ..core import exact
-from ..core.contacts import SPHERE_PLANE, ContactPoints, find_keys
+from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints, find_keys
 from ..core.profile import Stage
 from ..core.settings import BROAD_PHASE_STEPS, DEEP_OVERLAP, RETRIES, SPECULATIVE_REACH, SUBSTEP_TRAVEL
 from ..core.state import State, V, X
@@ -76,8 +77,9 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     # then this memory, not a copy of it)
     c.normal = np.asfortranarray(c.normal)
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
-    # them), and of the others, the pairs left out, only which bodies they join and their gaps
-    left = contacts.gaps().subset(~solved)
+    # them), and of the others, the pairs left out, only which bodies they join (found again from the
+    # kept pairs, ``LeftOut``) and their gaps
+    left = LeftOut(collision.pairs, ~solved, contacts.gap)
     del solved
     del contacts
     # the points of the pairs between balls are made again for the record (``_points``), not held
@@ -103,10 +105,31 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     return True
 
 
+class LeftOut:
+    """The kept pairs a soft frame does not solve, with their gaps at its start: which of the
+    narrow phase's contacts of ``pairs`` they are (``out``, a mask over them: a byte a pair) and their
+    gaps, not their kinds and bodies (9 bytes a pair), which ``points`` takes from ``pairs`` again, in
+    the order ``narrowphase.contact_points`` lays them out (sphere–plane pairs first)."""
+
+    def __init__(self, pairs: KeptPairs, out: np.ndarray, gap: np.ndarray) -> None:
+        self.pairs, self.out, self.gap = pairs, out, gap[out]
+
+    def points(self) -> ContactPoints:
+        """The pairs left out, as ``ContactPoints.gaps`` of their contacts: kind, a, other and gap."""
+        p, planes = self.pairs, len(self.pairs.sphere)
+        on_plane, between = self.out[:planes], self.out[planes:]
+        index = p.pair_i.dtype
+        kind = np.full(np.count_nonzero(on_plane) + np.count_nonzero(between), SPHERE_SPHERE, np.int8)
+        kind[: np.count_nonzero(on_plane)] = SPHERE_PLANE
+        a = np.concatenate((p.sphere[on_plane], p.pair_i[between]), dtype=index)
+        other = np.concatenate((p.plane[on_plane], p.pair_j[between]), dtype=index)
+        return ContactPoints(kind, a, None, other, self.gap, None, None)
+
+
 def _try(
     step: Step,
     motion: Motion,
-    left: ContactPoints,
+    left: LeftOut,
     c: ContactPoints,
     substeps: int,
     last: bool,
@@ -154,7 +177,7 @@ def _try(
 def verdict(
     step: Step,
     motion: Motion,
-    left: ContactPoints,
+    left: LeftOut,
     c: ContactPoints,
     frame: softstep.Frame,
     before: np.ndarray,
@@ -162,7 +185,7 @@ def verdict(
     """Whether a soft frame kept its promises (see ``frames``), or why it cannot be trusted.
 
     ``left`` are the kept pairs the frame did not solve (``c``), with their gaps at the frame's start
-    (``ContactPoints.gaps``), and ``before`` the balls' states then. A ball that left the box
+    (``LeftOut``), and ``before`` the balls' states then. A ball that left the box
     its pairs were found from may have met a body the broad phase never paired it with: the pairs are
     then found afresh around where the balls are now (they replace the kept pairs, as a split step's
     renewal does) and those new pairs are checked too."""
@@ -198,7 +221,7 @@ def verdict(
         out = now.subset(~_among(now.keys(), c.keys()))
         out.gap = _gap_from(out, before, model, state)
     else:
-        out = left
+        out = left.points()
         b = np.where(out.kind == SPHERE_PLANE, n, out.other)
         near = far[out.a] + far[b] >= out.gap  # only those whose balls got farther than their gap
         out = out.subset(near)
