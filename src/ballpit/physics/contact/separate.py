@@ -95,7 +95,7 @@ def planes_win(f: SoftFrame, model: Model, state: State) -> None:
         return
     body = state.body
     start = np.zeros((len(body), 3))
-    start[f.idx] = f.x0[:, : len(f.idx)].T
+    start[f.idx] = f.start().T
     a, nrm = c.a[on], c.normal[on]
     d = body[a, 0:3] - start[a]
     s = c.gap[on] + d[:, 0] * nrm[:, 0] + d[:, 1] * nrm[:, 1] + d[:, 2] * nrm[:, 2]

@@ -192,7 +192,7 @@ def integrate_positions(f: SoftFrame) -> None:
     moved = np.subtract(x, before, out=before)  # its squares then formed in place (norm_cols)
     length = np.empty(x.shape[1])
     np.maximum(f.largest[live], exact.norm_cols(moved, moved, length), out=f.largest[live])
-    np.subtract(x, f.x0[:, live], out=moved)
+    np.subtract(x, f.start(), out=moved)
     np.maximum(f.farthest[live], exact.norm_cols(moved, moved, length), out=f.farthest[live])
     np.minimum(f.lo, x, out=f.lo)
     np.maximum(f.hi, x, out=f.hi)
@@ -270,6 +270,7 @@ def store_impulses(
     f.k = None
     if before_write is not None:
         before_write()
+    f.keep_start()
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T
