@@ -363,6 +363,7 @@ class Viewer:
         width, height = self.window.get_framebuffer_size()
         view = self.view_target
         covered = round(self.panel.width * width / max(self.window.width, 1))  # framebuffer pixels
+        view.strip_color = self.panel.background
         drawn = view.begin(width, height, left=covered)
         key = self._view_key(shown, width, height)
         if not (view.keeps_image and key is not None and key == self._drawn_key):
