@@ -93,6 +93,7 @@ class WindowView:
         self.samples, self.scale = int(samples), float(scale)
         self.size = (0, 0)
         self.left = 0  # window pixels at the left not drawn (begin)
+        self.strip_color = (0.0, 0.0, 0.0)  # what the strip under the panel is cleared to
         self.target: Framebuffer | None = None  # drawn into (None: the window itself)
         self._texture_fbo = self._texture = self._depth = None
         self._program: Program | None = None
@@ -172,7 +173,7 @@ class WindowView:
             GL.glUseProgram(0)
         if left:  # under the panel: nothing of the view, a plain clear (the panel is drawn over it)
             GL.glScissor(0, 0, left, height)
-            GL.glClearColor(0.0, 0.0, 0.0, 1.0)
+            GL.glClearColor(*self.strip_color, 1.0)
             GL.glClear(GL.GL_COLOR_BUFFER_BIT)
             GL.glDisable(GL.GL_SCISSOR_TEST)
 

@@ -512,6 +512,9 @@ class Renderer:
         GL.glUseProgram(0)
         GL.glDisable(GL.GL_DEPTH_TEST)
         GL.glDisable(GL.GL_BLEND)
+        # hand the view to the rasteriser now: a CPU one (llvmpipe) draws it on its own thread while the
+        # caller lays out what goes over it, instead of starting when the image is first read
+        GL.glFlush()
         self.draw_seconds = time.perf_counter() - started
 
     def delete(self) -> None:
