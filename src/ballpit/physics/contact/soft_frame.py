@@ -134,9 +134,13 @@ class SoftFrame:
             return self._body[:, X].T
         return self._body[self.idx, X].T
 
-    def keep_start(self) -> None:
-        """Keep x₀ (``start``) of its own, before the balls' block changes."""
-        if self._x0 is None:
+    def keep_start(self, before: np.ndarray | None = None) -> None:
+        """Before the balls' block changes: read x₀ (``start``) from ``before``, a copy of the block as
+        the frame found it that nothing changes (the undo's: no third copy of the positions), or else
+        keep a copy of x₀ of its own."""
+        if before is not None:
+            self._body = before
+        elif self._x0 is None:
             self._x0 = self.start().copy()
 
     def ball_inverse_mass(self) -> np.ndarray:

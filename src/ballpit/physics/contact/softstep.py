@@ -96,13 +96,13 @@ def frame(
     warm: WarmStart,
     substeps: int,
     profile: StepProfile,
-    before_write: Callable[[], None] | None = None,
+    before_write: Callable[[], np.ndarray] | None = None,
 ) -> Frame:
     """Advance the balls the contacts ``c`` touch by ``dt`` in ``substeps`` substeps (their states
     change in place; planes and other balls do not move here). ``warm`` gives and keeps the impulses;
     ``threshold`` is the restitution threshold (m/s). Each stage is timed into ``profile``.
     ``before_write`` is called just before the balls' states first change (the step's undo copies
-    them then, ``Checkpoint.keep_balls``)."""
+    them then, ``Checkpoint.keep_balls``) and returns the balls' block as it was, read only."""
     with profile.stage(Stage.PREPARE_CONTACTS):
         f = SoftFrame(model, state, c, forces, dt, warm, substeps)
     for i in range(substeps):
@@ -250,7 +250,7 @@ def store_impulses(
     state: State,
     warm: WarmStart,
     added: np.ndarray,
-    before_write: Callable[[], None] | None = None,
+    before_write: Callable[[], np.ndarray] | None = None,
 ) -> None:
     """Keep the impulses for the next frame's warm start, and write the balls back into the state
     (calling ``before_write`` first).
@@ -268,9 +268,7 @@ def store_impulses(
     f.whole = f.k.whole
     f.inv_mass = f.k.inverse[0].copy()  # each ball's 1/m, as moving apart reads it
     f.k = None
-    if before_write is not None:
-        before_write()
-    f.keep_start()
+    f.keep_start(before_write() if before_write is not None else None)
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
+import numpy as np
+
 from ..collision.pairs import PairCache
 from ..contact.warm_start import WarmStart
 from ..core.state import SavedState, State
@@ -57,12 +59,14 @@ class Checkpoint:
         saved["state"] = parts.state.checkpoint(balls=not balls_later)
         return Checkpoint(saved)
 
-    def keep_balls(self, parts: Parts) -> None:
+    def keep_balls(self, parts: Parts) -> np.ndarray:
         """Copy the balls' block of ``parts`` into this checkpoint, if it was taken without it
-        (``balls_later``): to be called before the balls first change."""
+        (``balls_later``): to be called before the balls first change. Returns the checkpoint's block
+        (read only: the balls as they were)."""
         saved = self.saved["state"]
         if saved.body is None:
-            self.saved["state"] = saved._replace(body=parts.state.body.copy())
+            saved = self.saved["state"] = saved._replace(body=parts.state.body.copy())
+        return saved.body
 
     @property
     def state(self) -> SavedState:
