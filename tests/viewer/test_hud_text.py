@@ -87,3 +87,25 @@ def test_the_hud_text_scales_with_the_window_within_readable_bounds():
     assert font_size(800, 720) == pytest.approx(FONT_SIZE * 800 / 1280, abs=0.25)
     assert font_size(2560, 1440) == 2 * FONT_SIZE
     assert font_size(200, 100) == FONT_SIZE_RANGE[0] and font_size(8000, 8000) == FONT_SIZE_RANGE[1]
+
+
+def test_a_new_hud_text_lays_out_again_only_the_lines_that_changed(hud):
+    """pyglet lays a label's whole text out again when it changes: the HUD is a label per line, so a
+    new sim time re-lays that line and leaves the others' layouts as they were."""
+    lines = ["slopes.toml", "sim time        1.000 s", "balls               5", "F1 help"]
+    hud.set_text(lines)
+    laid_out = [0] * len(lines)
+    for index, label in enumerate(hud.label.labels):  # count each label's layouts (pyglet's _update)
+
+        def counted(update=label._update, index=index):
+            laid_out[index] += 1
+            update()
+
+        label._update = counted
+    hud.set_text([lines[0], "sim time        1.250 s", *lines[2:]])
+    assert [count > 0 for count in laid_out] == [False, True, False, False]
+    assert hud.text == hud.label.text == "\n".join([lines[0], "sim time        1.250 s", *lines[2:]])
+    hud.set_text(lines[:2])  # fewer lines: the rest go
+    assert len(hud.label.labels) == 2 and hud.label.content_height == pytest.approx(
+        2 * line_height(hud.label)
+    )

@@ -90,6 +90,101 @@ def help_text() -> str:
     return "\n".join(["ballpit controls", "", *rows, "", PLANE_LEGEND])
 
 
+class LineBlock:
+    """Lines of text drawn one under another as one pyglet label each, so changing the text lays out
+    again only the lines that changed. pyglet lays a label's whole text out again (glyph by glyph, in
+    Python) whenever any of it changes: as one multiline label the HUD's dozen lines took the window's
+    thread several milliseconds ten times a second, while only three or four of them change. Reads like
+    a multiline label: ``text``, ``font_size``, ``x``, ``y`` (its top left), ``content_width`` and
+    ``content_height``."""
+
+    def __init__(self, batch: pyglet.graphics.Batch, font_size: float, color: tuple[int, ...]) -> None:
+        self.batch, self.color = batch, color
+        self._font_size = font_size
+        self._x = self._y = 0.0
+        self.lines: list[str] = []
+        self.labels: list[pyglet.text.Label] = []
+        self._step = _line_step(font_size)
+
+    @property
+    def text(self) -> str:
+        return "\n".join(self.lines)
+
+    def set_lines(self, lines: Sequence[str]) -> None:
+        """Show ``lines``: the labels of lines that changed get their new text, the rest stay laid out."""
+        for index, line in enumerate(lines):
+            if index == len(self.labels):
+                self.labels.append(self._label(line, index))
+            elif self.lines[index] != line:
+                self.labels[index].text = line
+        for label in self.labels[len(lines) :]:
+            label.delete()
+        del self.labels[len(lines) :]
+        self.lines = list(lines)
+
+    def _label(self, text: str, index: int) -> pyglet.text.Label:
+        return pyglet.text.Label(
+            text, font_name=FONT, font_size=self._font_size, color=self.color, anchor_y="top",
+            x=self._x, y=self._y - index * self._step, batch=self.batch,
+        )  # fmt: skip
+
+    @property
+    def font_size(self) -> float:
+        return self._font_size
+
+    @font_size.setter
+    def font_size(self, size: float) -> None:
+        self._font_size, self._step = size, _line_step(size)
+        for label in self.labels:
+            label.font_size = size
+        self._place()
+
+    @property
+    def x(self) -> float:
+        return self._x
+
+    @x.setter
+    def x(self, value: float) -> None:
+        self._x = value
+        self._place()
+
+    @property
+    def y(self) -> float:
+        return self._y
+
+    @y.setter
+    def y(self, value: float) -> None:
+        self._y = value
+        self._place()
+
+    def _place(self) -> None:
+        for index, label in enumerate(self.labels):
+            label.position = (self._x, self._y - index * self._step, label.z)
+
+    @property
+    def content_width(self) -> float:
+        return max((label.content_width for label in self.labels), default=0)
+
+    @property
+    def content_height(self) -> float:
+        """As a multiline label's: a line's height for each line."""
+        return len(self.labels) * self._step
+
+
+_steps: dict[float, float] = {}
+
+
+def _line_step(size: float) -> float:
+    """The distance between the lines of a multiline label in the HUD's font at ``size`` points."""
+    if size not in _steps:
+        one = pyglet.text.Label("Xg", font_name=FONT, font_size=size, multiline=True, width=NO_WRAP)
+        two = pyglet.text.Label("Xg\nXg", font_name=FONT, font_size=size, multiline=True, width=NO_WRAP)
+        _steps[size] = two.content_height - one.content_height
+        one.delete()
+        two.delete()
+    return _steps[size]
+
+
 class Hud:
     """pyglet labels for the HUD panel, the help overlay, a transient message and the scene error."""
 
@@ -109,10 +204,7 @@ class Hud:
         self.left = 0  # pixels kept clear at the left (the panel): everything is drawn right of them
         self._help_layout_key: tuple = ()
         self.panel = pyglet.shapes.Rectangle(0, 0, 10, 10, color=PANEL_COLOR, batch=self.batch)
-        self.label = pyglet.text.Label(
-            "", font_name=FONT, font_size=FONT_SIZE, color=TEXT_COLOR, multiline=True, width=NO_WRAP,
-            anchor_y="top", batch=self.batch,
-        )  # fmt: skip
+        self.label = LineBlock(self.batch, FONT_SIZE, TEXT_COLOR)
         self.error_back = pyglet.shapes.Rectangle(0, 0, 10, 10, color=ERROR_BACK)
         self.error_label = pyglet.text.Label(
             "", font_name=FONT, font_size=FONT_SIZE, color=ERROR_COLOR, multiline=True, width=900,
@@ -200,7 +292,7 @@ class Hud:
         text = "\n".join(lines)
         if text != self.text:
             self.text = text
-            self.label.text = text
+            self.label.set_lines(lines)
             self._fit_panel()
 
     def set_error(self, error: str | None) -> None:
