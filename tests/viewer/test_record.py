@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ballpit import cli
 from ballpit.cli.trajectory import TRAJECTORY_COLUMNS
 from ballpit.scene import default_scene_path, read_scene
 
@@ -52,15 +53,11 @@ def finish(proc: subprocess.Popen) -> tuple[str, str]:
         pytest.fail(f"the viewer did not exit; {ended(proc)}")
 
 
-def simulate(scene: Path, steps: int, out: Path, workdir: Path) -> None:
-    """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep."""
+def simulate(scene: Path, steps: int, out: Path) -> None:
+    """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep (its command line run in
+    this process: the viewer's record is what runs apart)."""
     dt = read_scene(scene).timestep
-    proc = subprocess.run(
-        [sys.executable, "-m", "ballpit", "simulate", str(scene), "--duration", repr(steps * dt),
-         "--out", str(out), "-q"],
-        env=subprocess_env(None), cwd=workdir, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
+    assert cli.main(["simulate", str(scene), "--duration", repr(steps * dt), "--out", str(out), "-q"]) == 0
 
 
 def assert_same_trajectory(record, expected) -> None:
@@ -88,7 +85,7 @@ def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_
     steps = len(times) - 1  # the starting state, then one record per step
     assert steps > 100, steps
     assert f"recorded {steps} steps (5 balls) to run.npz" in out
-    simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
+    simulate(scene, steps, tmp_path / "sim.npz")
     assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
@@ -120,7 +117,7 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
     assert np.all(np.diff(times) > 0)  # no step twice, no jump back in time
     steps = len(times) - 1
     assert steps > 100, steps
-    simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
+    simulate(scene, steps, tmp_path / "sim.npz")
     assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
@@ -149,7 +146,7 @@ def test_ctrl_c_writes_the_record_and_a_shot_ball_gets_the_next_id(xvfb, tmp_pat
     steps = len(counts) - 1
     assert f"recorded {steps} steps (6 balls) to run.csv" in out
     # up to the shot, the same rows, to the character, as simulate writes
-    simulate(scene, first_six - 1, tmp_path / "sim.csv", tmp_path)
+    simulate(scene, first_six - 1, tmp_path / "sim.csv")
     expected = (tmp_path / "sim.csv").read_text().splitlines()
     assert lines[: len(expected)] == expected and len(expected) == 1 + 5 * first_six
 
