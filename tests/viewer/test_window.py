@@ -38,6 +38,13 @@ def run_scenario(display: str, name: str, workdir: Path) -> dict:
     return run_driver(DRIVER, display, name, workdir, timeout=120, batch=BATCH)
 
 
+def pixels(png: str) -> np.ndarray:
+    """A screenshot the window wrote (F12), as an (H, W, 3) int array."""
+    from PIL import Image
+
+    return np.asarray(Image.open(png).convert("RGB")).astype(int)
+
+
 def test_the_title_shows_the_frame_rate(xvfb, tmp_path):
     result = run_scenario(xvfb, "title", tmp_path)
     assert result["first"] == "ballpit — untitled — 0.0 FPS"
@@ -120,7 +127,7 @@ def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
     assert r["scene"] == "slopes.toml" and (width, height) == (1280, 720)
     left, top, right, bottom = r["hud"]
     # the featured top ball (purple, #9b5de5) is on screen from the first frame, not behind the HUD
-    first = np.array(r["first_frame"])
+    first = pixels(r["first_frame"])
     purple = (first[..., 2] > first[..., 0] + 40) & (first[..., 0] > first[..., 1] + 30)
     rows, cols = np.nonzero(purple)
     outside = ~((cols >= left) & (cols < right) & (rows >= top) & (rows < bottom))
@@ -170,7 +177,7 @@ def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
     # beside the ImGui panel the help's text shrinks to fit the 3-D view (950 px wide; 470 at 800x450)
     assert r["800x450 panel"]["left"] == 330 and r["800x450 panel"]["help"][2] <= 800
     # in the real pixels: the HUD's bright text shows in its panel, the gap between the panels is scene
-    image = np.array(r["1280x720"]["pixels"])
+    image = pixels(r["1280x720"]["pixels"])
     hud, help_ = (np.array(r["1280x720"][k], dtype=int) for k in ("hud", "help"))
     hud_pixels = image[hud[1] : hud[3], hud[0] : hud[2]]
     assert (hud_pixels.min(axis=-1) > 200).sum() > 200  # its text
