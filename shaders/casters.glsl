@@ -12,21 +12,34 @@ uniform vec2 u_caster_half[MAX_CASTERS];
 uniform vec3 u_caster_normal[MAX_CASTERS];
 uniform int u_caster_index[MAX_CASTERS];  // the plane's index, so a plane does not shade itself
 
+#ifndef CASTERS
+#define CASTERS MAX_CASTERS  // renderer.py compiles each program for the count it has
+#endif
+
+// The share of the sun point p sees past caster k, 1 if it is p's own plane (``self``), is edge on to
+// the sun, is not between p and the sun, or is beyond the count set (shadows switched off); the edge is
+// soft over the sun's angular radius, as a ball's is.
+float caster_shade(vec3 p, int self, int k) {
+    vec3 normal = u_caster_normal[k];
+    float facing = dot(u_sun_direction, normal);
+    float t = dot(u_caster_center[k] - p, normal) / facing;
+    vec3 q = p + t * u_sun_direction - u_caster_center[k];
+    vec2 outside = abs(vec2(dot(q, u_caster_u[k]), dot(q, u_caster_v[k]))) - u_caster_half[k];
+    float w = t * SUN_RADIUS + 1e-3;
+    float shade = smoothstep(-w, w, max(outside.x, outside.y));
+    bool casts = k < u_caster_count && u_caster_index[k] != self && abs(facing) >= 1e-4 && t > 1e-3;
+    return casts ? shade : 1.0;
+}
+
 // The fraction of the sun point p sees past the casting planes (the plane ``self`` left out, -1 for
-// none); the edge is soft over the sun's angular radius, as a ball's is.
+// none). Written out once per caster, with constant indices, up to the CASTERS the program was compiled
+// for: a CPU rasteriser (llvmpipe) reads a uniform array at a loop's index lane by lane, a gather per
+// component, and runs both sides of every branch, so a loop over the casters cost more than the rest
+// of the plane's shading together.
+#define CAST(k) if (k < CASTERS) sun = min(sun, caster_shade(p, self, k));
 float plane_shadow(vec3 p, int self) {
     float sun = 1.0;
-    for (int i = 0; i < u_caster_count; ++i) {
-        if (u_caster_index[i] == self) continue;
-        vec3 normal = u_caster_normal[i];
-        float facing = dot(u_sun_direction, normal);
-        if (abs(facing) < 1e-4) continue;  // edge on to the sun: no shadow to speak of
-        float t = dot(u_caster_center[i] - p, normal) / facing;
-        if (t <= 1e-3) continue;  // the plane is not between p and the sun
-        vec3 q = p + t * u_sun_direction - u_caster_center[i];
-        vec2 outside = abs(vec2(dot(q, u_caster_u[i]), dot(q, u_caster_v[i]))) - u_caster_half[i];
-        float w = t * SUN_RADIUS + 1e-3;
-        sun = min(sun, smoothstep(-w, w, max(outside.x, outside.y)));
-    }
+    CAST(0) CAST(1) CAST(2) CAST(3) CAST(4) CAST(5) CAST(6) CAST(7)
+    CAST(8) CAST(9) CAST(10) CAST(11) CAST(12) CAST(13) CAST(14) CAST(15)
     return sun;
 }

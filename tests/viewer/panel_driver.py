@@ -105,8 +105,9 @@ def wait_for(viewer: Viewer, condition, frames: int = 120) -> bool:
 
 # ---------------------------------------------------------------------- scenarios
 def scene_list(workdir: Path) -> dict:
-    """Click a bundled scene in the list: it loads, and the camera goes to its view; then F4 hides the
-    panel and the HUD moves to the window's edge."""
+    """Click a bundled scene in the list: it loads, and the camera goes to its view; the panel is opaque,
+    in ImGui's window colour; then F4 hides the panel, the view fills the strip and the HUD moves to the
+    window's edge."""
     viewer = panel_viewer(workdir)
     out: dict = {"before": viewer.sim.appearance.name, "panel_width": viewer.panel.width}
     out["hud_x_shown"] = viewer.hud.panel.x
@@ -126,7 +127,18 @@ def scene_list(workdir: Path) -> dict:
         "title": viewer.window.caption,
         "recent": [p.name for p in viewer.panel.recent],
     }
+    background = np.round(np.array(viewer.panel.background) * 255)
+    width = int(viewer.panel.width)
+
+    def background_share() -> float:
+        """The share of the strip the panel covers (when shown) that is its background colour."""
+        strip = grab(viewer)[:, :width].astype(float)
+        return float((np.abs(strip - background) <= 1).all(axis=-1).mean())
+
+    out["panel_background_share"] = background_share()
+    out["background"] = background.tolist()
     press(viewer, "F4", frames=3)
+    out["strip_background_share_hidden"] = background_share()
     out["panel_after_f4"] = viewer.panel.shown
     out["hud_x_hidden"] = viewer.hud.panel.x
     out["inset_hidden"] = viewer.camera.inset

@@ -54,6 +54,10 @@ def test_clicking_a_scene_in_the_list_loads_it_and_f4_hides_the_panel(xvfb, tmp_
     assert "cradle.toml" in r["title"] and r["recent"] == ["cradle.toml"]
     assert r["hud_x_shown"] >= r["panel_width"]  # the HUD sits right of the panel
     assert r["panel_after_f4"] is False and r["hud_x_hidden"] < 20 and r["inset_hidden"] == 0.0
+    # the panel is opaque: most of its strip is its background colour (the rest its widgets and text), not
+    # the scene's (the view is not drawn under it); hidden, the view fills the strip
+    assert max(r["background"]) > 0
+    assert r["panel_background_share"] > 0.5 and r["strip_background_share_hidden"] < 0.05
 
 
 def test_the_drop_pause_step_and_reset_buttons_do_what_their_keys_do_and_the_prompt_goes(xvfb, tmp_path):

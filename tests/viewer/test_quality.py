@@ -64,3 +64,43 @@ def test_the_half_resolution_view_stretched_over_the_frame_shows_the_same_pictur
     background = np.array(full[0, 0], dtype=int)
     balls = np.abs(full.astype(int) - background).sum(axis=-1) > 60
     assert balls.any() and (np.abs(stretched.astype(int) - background).sum(axis=-1) > 60).any()
+
+
+@pytest.mark.parametrize("samples, scale", [(0, 0.5), (0, 1.0), (4, 1.0), (4, 0.5)])
+def test_the_view_right_of_the_panel_is_the_same_picture_and_nothing_is_drawn_under_it(
+    offscreen, samples, scale
+):
+    """The panel is opaque, so the view is not shaded under it (WindowView.begin's ``left``): every
+    pixel right of the panel's edge is the one the whole view draws, and the strip under it is cleared."""
+    from OpenGL import GL
+
+    from ballpit.viewer.camera import Camera
+    from ballpit.viewer.framebuffer import WindowView
+    from ballpit.viewer.simulation import Simulation
+
+    sim = Simulation(line_of_balls(5))
+    camera = Camera.looking_at((-1, 4, 10), (-2, 3, 0))
+    camera.inset = 0.3
+    w, h = offscreen.width, offscreen.height
+    left = round(camera.inset * w)
+    offscreen.feeder.upload(sim, eye=camera.position)
+    images = {}
+    for covered in (0, left):
+        view = WindowView(samples=samples, scale=scale)
+        try:
+            offscreen.target.bind()
+            GL.glClearColor(0.9, 0.2, 0.6, 1.0)  # what a stale strip would show
+            GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+            drawn = view.begin(w, h, offscreen.target.fbo, left=covered)
+            offscreen.renderer.draw(camera, *drawn, multisample=view.multisample)
+            view.finish(w, h, offscreen.target.fbo)
+            assert not GL.glIsEnabled(GL.GL_SCISSOR_TEST)
+            images[covered] = offscreen.target.read()
+        finally:
+            view.delete()
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+    whole, cropped = images[0], images[left]
+    balls = np.abs(whole[:, left:].astype(int) - whole[0, -1].astype(int)).sum(axis=-1) > 60
+    assert balls.any()  # the comparison covers balls, not only the background
+    assert np.array_equal(cropped[:, left:], whole[:, left:])
+    assert (cropped[:, :left] == 0).all()

@@ -101,3 +101,14 @@ def test_a_uniform_already_holding_the_value_set_is_not_sent_again_and_a_new_val
     assert program.uniform_calls == 3 and np.array_equal(held.reshape(4, 4), first)
     GL.glUseProgram(0)
     program.delete()
+
+
+def test_defines_go_after_the_version_line_and_keep_the_line_numbers(tmp_path):
+    (tmp_path / "main.frag").write_text("#version 330 core\nvoid main() {}\n")
+    source, _ = load_source("main.frag", tmp_path, {"CASTERS": 3})
+    assert source.splitlines()[:4] == [
+        "#version 330 core",
+        "#define CASTERS 3",
+        "#line 2 0",
+        "void main() {}",
+    ]

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import ballpit
+from ballpit.viewer import renderer as renderer_module
 from ballpit.viewer import shadows
 from ballpit.viewer.camera import Camera
 from ballpit.viewer.simulation import Simulation
@@ -224,6 +225,52 @@ def test_a_ball_above_a_slope_shades_the_slope_and_casts_no_second_shadow_throug
     on_slope = center - t * SUN
     assert not covered[pixel(on_slope)]
     assert no_ball[pixel(on_slope)] - ball[pixel(on_slope)] > 100
+
+
+def test_the_casters_written_out_for_the_scene_shade_as_a_program_written_for_sixteen(offscreen):
+    """The plane and ball programs are compiled for the number of casting planes the scene has
+    (casters.glsl's CASTERS): the picture is the one a program written out for all sixteen draws."""
+    from ballpit.viewer.shaders import Program
+
+    sim = slope_scene(ball=True)
+    renderer = offscreen.renderer
+    drawn = offscreen.render(sim, CAMERA)
+    own = renderer.ball_program, renderer.plane_program
+    defines = {"CASTERS": renderer_module.MAX_CASTERS}
+    full = (
+        Program("ball.vert", "ball.frag", defines=defines),
+        Program("plane.vert", "plane.frag", defines=defines),
+    )
+    try:
+        full[1].use()
+        full[1].set_int("u_shadow_balls", renderer_module.SHADOW_BALLS_UNIT)
+        full[1].set_int("u_shadow_cells", renderer_module.SHADOW_CELLS_UNIT)
+        renderer.ball_program, renderer.plane_program = full
+        written_for_all = offscreen.draw(CAMERA)
+    finally:
+        renderer.ball_program, renderer.plane_program = own
+        for program in full:
+            program.delete()
+    no_slope = brightness(offscreen.render(slope_scene(ball=False), CAMERA))
+    assert (np.abs(no_slope - brightness(drawn)) > 100).any()  # the ball and its shadow are in it
+    assert np.abs(drawn.astype(int) - written_for_all.astype(int)).max() <= 1
+
+
+def test_each_of_several_slopes_shades_the_floor(offscreen):
+    """Two slopes side by side: the floor along the light under each is in its shade, whichever is
+    the first caster and whichever the second."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    centers = [np.array([-1.6, 1.0, -1.2]), np.array([0.6, 1.0, 0.4])]
+    for center in centers:
+        world.add_plane(position=tuple(center), rotation=(0, 0, 10), size=1.0)
+    image = brightness(offscreen.render(Simulation(world), CAMERA))
+    empty = brightness(offscreen.render(floor_scene([]), CAMERA))
+    for center in centers:
+        under = shadow_center(center)  # the floor point whose ray towards the sun meets the slope's middle
+        row, col = pixel(under)
+        assert 0 <= row < 150 and 0 <= col < 200
+        assert empty[row, col] - image[row, col] > 100
 
 
 # ---------------------------------------------------------------- the grid itself (no GL)

@@ -362,7 +362,9 @@ class Viewer:
         self.window.switch_to()
         width, height = self.window.get_framebuffer_size()
         view = self.view_target
-        drawn = view.begin(width, height)
+        covered = round(self.panel.width * width / max(self.window.width, 1))  # framebuffer pixels
+        view.strip_color = self.panel.background
+        drawn = view.begin(width, height, left=covered)
         key = self._view_key(shown, width, height)
         if not (view.keeps_image and key is not None and key == self._drawn_key):
             selected = self.interaction.selected_plane
@@ -372,10 +374,14 @@ class Viewer:
             self.renderer.draw(self.camera, *drawn, multisample=view.multisample)
             self._drawn_key, self._drawn_shown = key, shown
             self.views_drawn += 1
+        # the HUD's text and the panel are laid out while the rasteriser draws the view (renderer.draw
+        # flushes it), then stretched into the window, with the HUD, the labels and the panel over it
+        self._update_hud(now, shown)
+        self.panel.build(shown, rebuild=self.pacer.build_panel(now))
         view.finish(width, height)
-        self._draw_hud(now, shown)
+        self.hud.draw(now)
         self.screen.draw_labels()
-        self.panel.draw(shown, rebuild=self.pacer.build_panel(now))
+        self.panel.render()
         if self.screenshot_requested:
             self.screenshot_requested = False
             self.save_screenshot(width, height)
@@ -419,7 +425,8 @@ class Viewer:
         return " ".join(name for name, on in (("contacts", f.contacts), ("velocities", f.velocities),
                                               ("trails", f.trails)) if on)  # fmt: skip
 
-    def _draw_hud(self, now: float, shown: Shown) -> None:
+    def _update_hud(self, now: float, shown: Shown) -> None:
+        """The HUD's place and text for this frame (drawn after the view: ``Hud.draw``)."""
         from .hud import hud_lines, profile_lines
 
         if self.hud.bottom != self.screen.bottom_clearance() or self.hud.left != self.panel.width:
@@ -440,7 +447,6 @@ class Viewer:
             self._shown_message = shown.message
             if shown.message:
                 self.hud.flash(shown.message, now)
-        self.hud.draw(now)
 
     def _count_frame(self, now: float, shown: Shown) -> None:
         self.frames += 1

@@ -92,6 +92,8 @@ class WindowView:
     def __init__(self, samples: int, scale: float) -> None:
         self.samples, self.scale = int(samples), float(scale)
         self.size = (0, 0)
+        self.left = 0  # window pixels at the left not drawn (begin)
+        self.strip_color = (0.0, 0.0, 0.0)  # what the strip under the panel is cleared to
         self.target: Framebuffer | None = None  # drawn into (None: the window itself)
         self._texture_fbo = self._texture = self._depth = None
         self._program: Program | None = None
@@ -107,8 +109,12 @@ class WindowView:
         an unchanged view can be shown again by ``finish`` alone, without drawing it."""
         return self.target is not None or self._texture is not None
 
-    def begin(self, width: int, height: int, destination: int = 0) -> tuple[int, int]:
-        """Bind where to draw for a window of ``width`` x ``height`` pixels; returns the size to draw at."""
+    def begin(self, width: int, height: int, destination: int = 0, left: int = 0) -> tuple[int, int]:
+        """Bind where to draw for a window of ``width`` x ``height`` pixels; returns the size to draw at.
+        ``left``: pixels at the window's left an opaque panel covers. The view is still laid out over the
+        whole window (the camera's inset centres it right of the panel), but no pixel under the panel is
+        shaded or stretched: on a CPU rasteriser every pixel costs, and the panel is a quarter of a
+        1280-pixel window."""
         size = (max(round(width * self.scale), 1), max(round(height * self.scale), 1))
         if size != self.size:
             self._free()
@@ -117,22 +123,41 @@ class WindowView:
                 self.target = Framebuffer(*size, self.samples)
             if size != (width, height):
                 self._make_texture(*size)
+        self.left = min(max(int(left), 0), width)
         if self.target is not None:
             self.target.bind()
         elif self._texture_fbo is not None:
             GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._texture_fbo)
         else:
             GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, destination)
+        if self.left:
+            first = self._first_column(width)
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(first, 0, size[0] - first, size[1])
         return size
+
+    def _first_column(self, width: int) -> int:
+        """The view's first column drawn: the one under the panel's edge, and one more to its left,
+        which the bilinear stretch blends into the window's first column past the panel."""
+        return max(int(self.left * self.size[0] / width) - 1, 0)
 
     def finish(self, width: int, height: int, destination: int = 0) -> None:
         """Resolve and stretch the view into the window's back buffer (or the framebuffer
-        ``destination``); leaves that bound."""
+        ``destination``) right of the panel (``begin``'s ``left``), clear the strip under the panel;
+        leaves that bound, with no scissor."""
         w, h = self.size
+        left = self.left
+        if left:
+            GL.glScissor(left, 0, width - left, height)
         if self.target is not None:  # resolve the samples: into the texture, or straight into the window
             GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.target.fbo)
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._texture_fbo or destination)
+            if self._texture_fbo:  # the texture is as large as the view: its columns, not the window's
+                first = self._first_column(width)
+                GL.glScissor(first, 0, w - first, h)
             GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+            if self._texture_fbo and left:
+                GL.glScissor(left, 0, width - left, height)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, destination)
         GL.glViewport(0, 0, width, height)
         if self._texture is not None:
@@ -146,6 +171,11 @@ class WindowView:
             GL.glBindVertexArray(0)
             GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
             GL.glUseProgram(0)
+        if left:  # under the panel: nothing of the view, a plain clear (the panel is drawn over it)
+            GL.glScissor(0, 0, left, height)
+            GL.glClearColor(*self.strip_color, 1.0)
+            GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
 
     def _make_texture(self, width: int, height: int) -> None:
         self._texture = GL.glGenTextures(1)

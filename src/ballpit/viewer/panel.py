@@ -79,6 +79,11 @@ class Panel:
         self.viewer = viewer
         self.backend = PanelBackend(viewer.window)
         self.shown = True
+        # The panel's background, ImGui's own window colour: the window clears the strip under the panel
+        # to it (framebuffer.WindowView), and ImGui does not fill it again (a blended fill of a third of
+        # a million pixels cost a CPU rasteriser about 2 ms a frame; the clear a fraction of that).
+        bg = imgui.get_style().color_(imgui.Col_.window_bg)
+        self.background = (bg.x, bg.y, bg.z)
         self.edits = Edits(viewer.physics.submit)
         self.plots = dict.fromkeys(PLOTS, False) | {"energy": True, "ball": True}
         self.sections = {"Scenes": True, "Simulation": True, "Inspector": True, "Plots": False, "View": False}
@@ -93,6 +98,8 @@ class Panel:
         # wall time also holds the waits for the GIL and for a core while the physics thread runs)
         self.seconds: deque[float] = deque(maxlen=240)
         self.cpu_seconds: deque[float] = deque(maxlen=240)
+        self._rebuilt = True  # the last ``build`` laid the panel out anew (else its last build is drawn)
+        self._spent = (0.0, 0.0)  # wall and thread time the last build took
         self._window = (0.0, 0.0, 0.0, 0.0)
         self._bundled = [path.resolve() for path in bundled_scenes()]
         self._prompt_key: tuple = ()
@@ -145,23 +152,37 @@ class Panel:
     def draw(self, shown: Shown, rebuild: bool = True) -> None:
         """Build the panel for ``shown`` and draw it; without ``rebuild``, draw its last build again
         when no input came since (the window's frames while the physics is busy: pacing.py)."""
+        self.build(shown, rebuild)
+        self.render()
+
+    def build(self, shown: Shown, rebuild: bool = True) -> None:
+        """Lay the panel out for ``shown`` (ImGui's widgets, Python on the window's thread), for
+        ``render`` to draw: the window builds it while the rasteriser draws the 3-D view. Without
+        ``rebuild`` and with no input since, the last build is kept."""
         started, cpu = time.perf_counter(), time.thread_time()
-        if not rebuild and self.backend.redraw():
-            self.seconds.append(time.perf_counter() - started)
-            self.cpu_seconds.append(time.thread_time() - cpu)
-            return
-        self.backend.new_frame()
-        watch: Watch | None = shown.watch
-        if self.shown and watch is not None:
-            self._panel(shown, watch)
+        self._rebuilt = rebuild or not self.backend.can_redraw()
+        if self._rebuilt:
+            self.backend.new_frame()
+            watch: Watch | None = shown.watch
+            if self.shown and watch is not None:
+                self._panel(shown, watch)
+            else:
+                self._window = (0.0, 0.0, 0.0, 0.0)
+            if watch is not None and watch.world.phase is Phase.WAITING and not watch.world.replay:
+                self._prompt(shown)
+            self._poll_dialog()
+        self._spent = (time.perf_counter() - started, time.thread_time() - cpu)
+
+    def render(self) -> None:
+        """Draw what ``build`` laid out (or its last build again) into the window."""
+        started, cpu = time.perf_counter(), time.thread_time()
+        if self._rebuilt:
+            self.backend.render()
         else:
-            self._window = (0.0, 0.0, 0.0, 0.0)
-        if watch is not None and watch.world.phase is Phase.WAITING and not watch.world.replay:
-            self._prompt(shown)
-        self._poll_dialog()
-        self.backend.render()
-        self.seconds.append(time.perf_counter() - started)
-        self.cpu_seconds.append(time.thread_time() - cpu)
+            self.backend.redraw()
+        wall, thread = self._spent
+        self.seconds.append(wall + time.perf_counter() - started)
+        self.cpu_seconds.append(thread + time.thread_time() - cpu)
 
     def _remember(self, key: str) -> None:
         lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
@@ -218,7 +239,7 @@ class Panel:
         h = self.viewer.window.height
         imgui.set_next_window_pos(ImVec2(0, 0))
         imgui.set_next_window_size(ImVec2(WIDTH, h))
-        imgui.set_next_window_bg_alpha(0.86)
+        imgui.set_next_window_bg_alpha(0.0)  # the strip under it is cleared to ``background``
         flags = (
             imgui.WindowFlags_.no_move
             | imgui.WindowFlags_.no_resize

@@ -218,12 +218,16 @@ class PanelBackend:
         self._built = True
         self.renderer.render(imgui.get_draw_data())
 
+    def can_redraw(self) -> bool:
+        """Whether ``redraw`` would draw: a frame was built and no input came since."""
+        return self._built and not self.fed
+
     def redraw(self) -> bool:
         """Draw the last built frame again (ImGui keeps its draw data until the next ``new_frame``);
         False, drawing nothing, when input came since or there is no frame to draw. Its clip rectangles
         were scaled to the framebuffer when it was built, and are not scaled again."""
         self.activate()
-        if self.fed or not self._built:
+        if not self.can_redraw():
             return False
         self.renderer.render(imgui.get_draw_data(), fresh=False)
         self.redraws += 1

@@ -121,8 +121,10 @@ class Renderer:
     """Owns the GL programs and buffers of the 3-D view (not the HUD)."""
 
     def __init__(self, shader_directory: object = None) -> None:
-        self.ball_program = Program("ball.vert", "ball.frag", shader_directory)
-        self.plane_program = Program("plane.vert", "plane.frag", shader_directory)
+        self._shader_directory = shader_directory
+        # the ball and plane programs by the number of shadow casters they were compiled for
+        self._caster_programs: dict[int, tuple[Program, Program]] = {}
+        self._programs_for(0)
         self.line_program = Program("line.vert", "line.frag", shader_directory)
         self.draws = DrawLog()
         self.background = np.array(BACKGROUND, dtype=np.float32)
@@ -192,10 +194,6 @@ class Renderer:
             GL.glTexBuffer(GL.GL_TEXTURE_BUFFER, fmt, buffer)
         GL.glBindTexture(GL.GL_TEXTURE_BUFFER, 0)
         GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, 0)
-        self.plane_program.use()
-        self.plane_program.set_int("u_shadow_balls", SHADOW_BALLS_UNIT)
-        self.plane_program.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
-        GL.glUseProgram(0)
 
         # trails (a triangle strip, depth tested) then overlay lines (always on top), in one buffer
         self.line_vao, self.line_vbo = _vertex_array()
@@ -250,6 +248,24 @@ class Renderer:
         self._casters = {"u_caster_center": centers[casts], "u_caster_u": u[casts], "u_caster_v": v[casts],
                          "u_caster_half": half[casts], "u_caster_normal": n[casts]}  # fmt: skip
         self._caster_index = casts
+        self._programs_for(len(casts))
+
+    def _programs_for(self, casters: int) -> None:
+        """Draw balls and planes with the programs compiled for ``casters`` shadow casters (compiled
+        the first time that count is asked for: the casters are written out one by one in the shader,
+        casters.glsl, so a frame pays for the casters the scene has, not for ``MAX_CASTERS``)."""
+        programs = self._caster_programs.get(casters)
+        if programs is None:
+            defines = {"CASTERS": casters}
+            directory = self._shader_directory
+            ball = Program("ball.vert", "ball.frag", directory, defines)
+            plane = Program("plane.vert", "plane.frag", directory, defines)
+            plane.use()
+            plane.set_int("u_shadow_balls", SHADOW_BALLS_UNIT)
+            plane.set_int("u_shadow_cells", SHADOW_CELLS_UNIT)
+            GL.glUseProgram(0)
+            programs = self._caster_programs[casters] = (ball, plane)
+        self.ball_program, self.plane_program = programs
 
     def upload_balls(
         self,
@@ -496,12 +512,16 @@ class Renderer:
         GL.glUseProgram(0)
         GL.glDisable(GL.GL_DEPTH_TEST)
         GL.glDisable(GL.GL_BLEND)
+        # hand the view to the rasteriser now: a CPU one (llvmpipe) draws it on its own thread while the
+        # caller lays out what goes over it, instead of starting when the image is first read
+        GL.glFlush()
         self.draw_seconds = time.perf_counter() - started
 
     def delete(self) -> None:
         """Free the GL objects (the context must be current)."""
-        for program in (self.ball_program, self.plane_program, self.line_program):
+        for program in (*(p for pair in self._caster_programs.values() for p in pair), self.line_program):
             program.delete()
+        self._caster_programs.clear()
         GL.glDeleteBuffers(
             6,
             [

@@ -2,8 +2,9 @@
 
 Sources may pull in shared code with ``#include "name.glsl"``; the loader splices the file in between
 ``#line`` directives so the driver's log still points at the right file and line (GLSL numbers source
-strings: 0 is the main file, 1, 2, ... the includes in order). Compile and link failures raise
-``ShaderError`` naming the file and quoting the driver's log.
+strings: 0 is the main file, 1, 2, ... the includes in order). A program may be compiled with
+``defines`` (``#define NAME VALUE`` lines after ``#version``), such as how many shadow casters to
+unroll. Compile and link failures raise ``ShaderError`` naming the file and quoting the driver's log.
 """
 
 from __future__ import annotations
@@ -36,9 +37,11 @@ def shader_dir() -> Traversable:
         ) from None
 
 
-def load_source(name: str, directory: Traversable | Path | None = None) -> tuple[str, list[str]]:
+def load_source(
+    name: str, directory: Traversable | Path | None = None, defines: dict[str, int] | None = None
+) -> tuple[str, list[str]]:
     """The text of shader ``name`` with its includes spliced in, and the file names by source-string
-    number (index 0 is ``name``)."""
+    number (index 0 is ``name``); ``defines`` go after its first line (``#version``)."""
     directory = shader_dir() if directory is None else directory
     files: list[str] = [name]
 
@@ -52,6 +55,9 @@ def load_source(name: str, directory: Traversable | Path | None = None) -> tuple
     def expand(file: str, number: int) -> str:
         out: list[str] = []
         for lineno, line in enumerate(read(file).splitlines(), start=1):
+            if number == 0 and lineno == 2 and defines:
+                out.extend(f"#define {key} {value}" for key, value in defines.items())
+                out.append(f"#line 2 {number}")
             match = _INCLUDE.match(line)
             if match is None:
                 out.append(line)
@@ -72,7 +78,9 @@ def _describe_sources(files: list[str]) -> str:
     return " (source strings: " + ", ".join(f"{i} = {f}" for i, f in enumerate(files)) + ")"
 
 
-def compile_shader(name: str, directory: Traversable | Path | None = None) -> int:
+def compile_shader(
+    name: str, directory: Traversable | Path | None = None, defines: dict[str, int] | None = None
+) -> int:
     """Compile one shader file (its stage from the suffix: .vert or .frag); returns the GL name."""
     from OpenGL import GL
 
@@ -80,7 +88,7 @@ def compile_shader(name: str, directory: Traversable | Path | None = None) -> in
     suffix = Path(name).suffix
     if suffix not in stages:
         raise ShaderError(f"{name}: unknown shader stage (expected .vert or .frag)")
-    source, files = load_source(name, directory)
+    source, files = load_source(name, directory, defines)
     shader = GL.glCreateShader(stages[suffix])
     GL.glShaderSource(shader, source)
     GL.glCompileShader(shader)
@@ -100,11 +108,17 @@ class Program:
     frame, and each GL call through PyOpenGL costs the window's thread tens of microseconds of Python.
     """
 
-    def __init__(self, vertex: str, fragment: str, directory: Traversable | Path | None = None) -> None:
+    def __init__(
+        self,
+        vertex: str,
+        fragment: str,
+        directory: Traversable | Path | None = None,
+        defines: dict[str, int] | None = None,
+    ) -> None:
         from OpenGL import GL
 
         self.name = f"{vertex} + {fragment}"
-        shaders = [compile_shader(vertex, directory), compile_shader(fragment, directory)]
+        shaders = [compile_shader(vertex, directory, defines), compile_shader(fragment, directory, defines)]
         program = GL.glCreateProgram()
         for shader in shaders:
             GL.glAttachShader(program, shader)
