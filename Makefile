@@ -7,13 +7,19 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 PYTEST_ARGS ?=  # more for pytest: make test PYTEST_ARGS=--durations=20
+# The tests start some 200 Python processes (window drivers, command lines, children), each importing
+# NumPy and ballpit, most of them pyglet too. Where the environment says PYTHONDONTWRITEBYTECODE (this
+# machine's does), every one of them compiled those modules from source again, and each pytest process
+# rewrote every test module's asserts again: about 0.2 CPU-s a process. The tests write the bytecode,
+# under .venv/pycache (out of the source tree; make clean removes it).
+PYTEST_ENV := PYTHONDONTWRITEBYTECODE= PYTHONPYCACHEPREFIX=$(CURDIR)/$(VENV)/pycache
 
 .PHONY: demo check test lint format bench clean
 
 # The installs go through uv (from PyPI, into the venv): it links the wheels from its cache instead of
-# unpacking them, and compiles no bytecode (Python compiles the modules the run imports when it first
-# does). From a clone, with the caches warm: the test install 10 s instead of pip's 19-27 (its 330 MB
-# of PyBullet data alone took pip several seconds). Where uv cannot be had, pip does the same install.
+# unpacking them, and compiles no bytecode (the tests compile what they import, PYTEST_ENV above).
+# From a clone, with the caches warm: the test install 10 s instead of pip's 19-27 (its 330 MB of
+# PyBullet data alone took pip several seconds). Where uv cannot be had, pip does the same install.
 INSTALL = $(PY) -m pip install --quiet uv && $(VENV)/bin/uv pip install --quiet --python $(PY) -e
 PIP_INSTALL = $(PY) -m pip install --quiet --no-compile -e
 
@@ -35,12 +41,12 @@ demo: $(VENV)/.ballpit
 check: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -q -n auto -m "not slow and not window" $(PYTEST_ARGS)
+	$(PYTEST_ENV) $(PY) -m pytest -q -n auto -m "not slow and not window" $(PYTEST_ARGS)
 
 test: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(PY) -m pytest -n auto --dist loadgroup $(PYTEST_ARGS)
+	$(PYTEST_ENV) $(PY) -m pytest -n auto --dist loadgroup $(PYTEST_ARGS)
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

@@ -24,16 +24,16 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def test_a_closed_stdout_ends_the_run_quietly():
     """`ballpit scenes | head -0`: the reader is gone before anything is written."""
-    proc = subprocess.Popen(
+    with subprocess.Popen(
         [sys.executable, "-m", "ballpit", "scenes"],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-    )
-    proc.stdout.close()
-    stderr = proc.stderr.read()
-    proc.wait(timeout=60)
+    ) as proc:  # on the way out its pipes are closed and it is reaped
+        proc.stdout.close()
+        stderr = proc.stderr.read()
+        proc.wait(timeout=60)
     assert "Traceback" not in stderr and "BrokenPipeError" not in stderr, stderr
     assert stderr == ""
     assert proc.returncode == cli.EXIT_BROKEN_PIPE
@@ -132,14 +132,14 @@ def test_ctrl_c_at_any_moment_after_python_started_exits_130_in_one_line():
     code = _STARTED_THEN_MAIN.format(module=spec.module, function=spec.attr)
     rng = random.Random(32)
     for _ in range(12):
-        proc = subprocess.Popen(
+        with subprocess.Popen(
             [sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
-        )
-        assert proc.stderr.read(1) == b"!"
-        time.sleep(rng.uniform(0.005, 0.25))  # the imports, the scene, the check itself
-        proc.send_signal(signal.SIGINT)
-        stderr = proc.stderr.read().decode()
-        proc.wait(timeout=60)
+        ) as proc:
+            assert proc.stderr.read(1) == b"!"
+            time.sleep(rng.uniform(0.005, 0.25))  # the imports, the scene, the check itself
+            proc.send_signal(signal.SIGINT)
+            stderr = proc.stderr.read().decode()
+            proc.wait(timeout=60)
         assert "Traceback" not in stderr, stderr
         if proc.returncode == -signal.SIGINT:
             # The signal came after main had returned and given Ctrl+C back: Python then ends by the

@@ -14,6 +14,8 @@ import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +54,11 @@ def xvfb():
     if shutil.which("Xvfb") is None:
         pytest.skip("Xvfb is not installed (apt-get install xvfb); .ci/run installs it")
     read, write = os.pipe()
+    # -noreset: by default the server resets when its last client leaves, and drops a client that
+    # connected meanwhile (its XOpenDisplay fails: the viewer then exits 1 as if there were no display).
+    # A test's xdotool calls come and go while the viewer it started is still connecting.
     proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1280x720x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1280x720x24", "-nolisten", "tcp", "-noreset"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         pass_fds=(write,),
@@ -71,7 +76,7 @@ def xvfb():
     os.close(read)
     if proc.poll() is not None or not number.strip():
         proc.kill()
-        error = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+        error = proc.communicate()[1].decode(errors="replace")  # reaped, its pipe closed
         pytest.fail(f"Xvfb did not start: {error}")
     try:
         yield f":{int(number)}"
@@ -81,6 +86,8 @@ def xvfb():
             proc.wait(timeout=5)
         except subprocess.TimeoutExpired:
             proc.kill()
+            proc.wait()
+        proc.stderr.close()
 
 
 def subprocess_env(display: str | None) -> dict[str, str]:
@@ -92,6 +99,37 @@ def subprocess_env(display: str | None) -> dict[str, str]:
         env["DISPLAY"] = display
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO / "src"), env.get("PYTHONPATH")]))
     return env
+
+
+def xdotool(display: str, *args: str) -> str:
+    """``xdotool ARGS`` on ``display``; what it printed."""
+    out = subprocess.run(
+        ["xdotool", *args], env=subprocess_env(display), capture_output=True, text=True, timeout=20
+    )
+    return out.stdout.strip()
+
+
+@contextmanager
+def started(args: Sequence[str], display: str, cwd: Path) -> Iterator[subprocess.Popen]:
+    """``args`` in a process of its own under ``display``, stdout and stderr to text pipes. On the way
+    out, also when the test fails, it is killed if still running, reaped, and its pipes are closed
+    (else a failed test leaves them to the collector, whose "unclosed file" warnings land in whatever
+    test of the worker runs then)."""
+    proc = subprocess.Popen(
+        args, env=subprocess_env(display), cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        yield proc
+    finally:
+        ended(proc)
+
+
+def ended(proc: subprocess.Popen) -> str:
+    """Kill ``proc`` if it still runs, reap it and close its pipes; what it wrote, for a message."""
+    if proc.poll() is None:
+        proc.kill()
+    out, err = proc.communicate()
+    return f"exit status {proc.returncode}; stdout {out!r}; stderr {err!r}"
 
 
 def _run_scenarios(driver: Path, display: str, names: list[str], workdir: Path, *extra: str,

@@ -91,9 +91,11 @@ def test_in_real_time_the_ghosts_are_drawn_at_the_step_shown_and_esc_esc_ends_th
     assert r["pid_gone"]
 
 
-@pytest.fixture
-def slopes_run(tmp_path) -> Path:
-    out = tmp_path / "run.npz"
+@pytest.fixture(scope="module")
+def slopes_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A ``ballpit simulate`` trajectory of the slopes demo (2 s), made once for the replay tests (they
+    only read it; BATCH keeps this module's tests on one worker)."""
+    out = tmp_path_factory.mktemp("slopes_run") / "run.npz"
     proc = subprocess.run(
         [sys.executable, "-m", "ballpit", "simulate", str(REPO / "scenes" / "slopes.toml"), "--duration", "2",
          "--out", str(out), "-q"],
@@ -104,7 +106,7 @@ def slopes_run(tmp_path) -> Path:
 
 
 def test_a_simulate_trajectory_replays_with_pause_step_scrub_and_time_scale(xvfb, tmp_path, slopes_run):
-    r = run_scenario(xvfb, "replay", tmp_path, str(REPO / "scenes" / "slopes.toml"), slopes_run.name)
+    r = run_scenario(xvfb, "replay", tmp_path, str(REPO / "scenes" / "slopes.toml"), str(slopes_run))
     assert r["phase"] == "RUNNING" and r["first"] == [0, True]
     frame, time, matches = r["after_half_second"]
     assert 118 <= frame <= 120 and matches and time == pytest.approx(frame / 240, abs=1e-6)
@@ -123,7 +125,7 @@ def test_b_and_dragging_a_ball_in_a_replay_are_refused_with_a_message_and_the_re
     xvfb, tmp_path, slopes_run
 ):
     r = run_scenario(
-        xvfb, "replay_refuses_reaching_in", tmp_path, str(REPO / "scenes" / "slopes.toml"), slopes_run.name
+        xvfb, "replay_refuses_reaching_in", tmp_path, str(REPO / "scenes" / "slopes.toml"), str(slopes_run)
     )
     assert r["before"]["phase"] == "RUNNING" and r["before"]["balls"] == 5
     assert "not available in a replay" in r["b_message"]

@@ -15,7 +15,7 @@ import pytest
 
 from ballpit.viewer.simulation import STATS_WINDOW
 
-from .conftest import run_driver, subprocess_env
+from .conftest import ended, run_driver, started, xdotool
 
 DRIVER = Path(__file__).with_name("window_driver.py")
 
@@ -87,47 +87,31 @@ def test_a_real_escape_escape_ends_the_app_mid_step_without_waiting_for_it(xvfb,
     """``ballpit view pile10k.toml``, X, then Esc, Esc typed through the X server while the pile lands:
     the window goes at once, and the process ends cleanly without finishing the step in progress."""
     code = "import sys; from ballpit.cli import main; sys.exit(main(['view', 'pile10k']))"
-    proc = subprocess.Popen(
-        [sys.executable, "-c", code], env=subprocess_env(xvfb), cwd=tmp_path,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
-
-    def xdotool(*args: str) -> str:
-        out = subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=20,
-                             env=subprocess_env(xvfb))  # fmt: skip
-        return out.stdout.strip()
-
-    try:
+    with started([sys.executable, "-c", code], xvfb, tmp_path) as proc:
         window = ""
         deadline = time.monotonic() + 90
         while not window and time.monotonic() < deadline and proc.poll() is None:
-            window = xdotool("search", "--name", "pile10k.toml").split("\n")[0]
+            window = xdotool(xvfb, "search", "--name", "pile10k.toml").split("\n")[0]
             time.sleep(0.2)
-        assert window, f"the viewer window never appeared (exit status {proc.poll()})"
-        xdotool("mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
+        assert window, f"the viewer window never appeared: {ended(proc)}"
+        xdotool(xvfb, "mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
         time.sleep(1.0)
-        xdotool("key", "x")
+        xdotool(xvfb, "key", "x")
         time.sleep(4.0)  # the pile falls and lands: steps of a few tenths of a second each
-        name = xdotool("getwindowname", window)
-        xdotool("key", "Escape")
+        name = xdotool(xvfb, "getwindowname", window)
+        xdotool(xvfb, "key", "Escape")
         time.sleep(0.4)
         assert proc.poll() is None, "one Escape quit the viewer; it should ask for a second"
         pressed = time.monotonic()
-        xdotool("key", "Escape")
+        xdotool(xvfb, "key", "Escape")
         closed_seconds = None
         while closed_seconds is None and time.monotonic() - pressed < 10:
-            if not xdotool("search", "--name", "pile10k.toml"):
+            if not xdotool(xvfb, "search", "--name", "pile10k.toml"):
                 closed_seconds = time.monotonic() - pressed
         try:
-            out, err = proc.communicate(timeout=30)
+            _out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
-            proc.kill()
-            out, err = proc.communicate()
-            pytest.fail(f"the viewer did not quit on Escape; stdout {out!r}; stderr {err!r}")
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+            pytest.fail(f"the viewer did not quit on Escape; {ended(proc)}")
     assert proc.returncode == 0, err
     assert "Traceback" not in err and "Fatal" not in err, err
     fps = float(re.search(r"(\d+\.\d) FPS$", name).group(1))

@@ -9,15 +9,18 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from ballpit import cli
 from ballpit.cli.trajectory import TRAJECTORY_COLUMNS
 from ballpit.scene import default_scene_path, read_scene
 
-from .conftest import run_driver, subprocess_env
+from .conftest import ended, run_driver, started, subprocess_env, xdotool
 from .test_reach import DRIVER as REACH_DRIVER
 
 # record_close_button runs on its own (REACH_DRIVER): asked through test_reach's batch, a worker without
@@ -26,48 +29,35 @@ from .test_reach import DRIVER as REACH_DRIVER
 needs_xdotool = pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 
 
-def xdotool(display: str, *args: str) -> str:
-    out = subprocess.run(
-        ["xdotool", *args], env=subprocess_env(display), capture_output=True, text=True, timeout=20
-    )
-    return out.stdout.strip()
-
-
-def open_viewer(display: str, workdir: Path, *args: str) -> tuple[subprocess.Popen, str]:
-    """``ballpit view ARGS`` in its own process; returns it and its window once frames flow."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "ballpit", "view", *args], env=subprocess_env(display), cwd=workdir,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    window, name = "", ""
-    deadline = time.monotonic() + 60
-    while not re.search(r"[1-9]\d*\.\d FPS$", name) and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.2)
-        window = window or xdotool(display, "search", "--name", "slopes.toml").split("\n")[0]
-        name = xdotool(display, "getwindowname", window) if window else ""
-    assert window and proc.poll() is None, f"no viewer window (exit status {proc.poll()})"
-    xdotool(display, "mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
-    return proc, window
+@contextmanager
+def viewer(display: str, workdir: Path, *args: str) -> Iterator[subprocess.Popen]:
+    """``ballpit view ARGS`` in its own process, once frames flow in its window (the pointer on it)."""
+    with started([sys.executable, "-m", "ballpit", "view", *args], display, workdir) as proc:
+        window, name = "", ""
+        deadline = time.monotonic() + 60
+        while (
+            not re.search(r"[1-9]\d*\.\d FPS$", name) and time.monotonic() < deadline and proc.poll() is None
+        ):
+            time.sleep(0.2)
+            window = window or xdotool(display, "search", "--name", "slopes.toml").split("\n")[0]
+            name = xdotool(display, "getwindowname", window) if window else ""
+        assert window and proc.poll() is None, f"no viewer window: {ended(proc)}"
+        xdotool(display, "mousemove", "--window", window, "20", "20")  # pointer focus for XTEST input
+        yield proc
 
 
 def finish(proc: subprocess.Popen) -> tuple[str, str]:
     try:
         return proc.communicate(timeout=60)
     except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        pytest.fail(f"the viewer did not exit; stdout {out!r}; stderr {err!r}")
+        pytest.fail(f"the viewer did not exit; {ended(proc)}")
 
 
-def simulate(scene: Path, steps: int, out: Path, workdir: Path) -> None:
-    """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep."""
+def simulate(scene: Path, steps: int, out: Path) -> None:
+    """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep (its command line run in
+    this process: the viewer's record is what runs apart)."""
     dt = read_scene(scene).timestep
-    proc = subprocess.run(
-        [sys.executable, "-m", "ballpit", "simulate", str(scene), "--duration", repr(steps * dt),
-         "--out", str(out), "-q"],
-        env=subprocess_env(None), cwd=workdir, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
+    assert cli.main(["simulate", str(scene), "--duration", repr(steps * dt), "--out", str(out), "-q"]) == 0
 
 
 def assert_same_trajectory(record, expected) -> None:
@@ -81,17 +71,13 @@ def assert_same_trajectory(record, expected) -> None:
 def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_path):
     scene = tmp_path / "slopes.toml"
     shutil.copy(default_scene_path(), scene)
-    proc, _ = open_viewer(xvfb, tmp_path, str(scene), "--record", "run.npz")
-    try:
+    with viewer(xvfb, tmp_path, str(scene), "--record", "run.npz") as proc:
         xdotool(xvfb, "key", "x")
         time.sleep(2.0)  # the drop, the first bounces and spins
         xdotool(xvfb, "key", "Escape")
         time.sleep(0.3)
         xdotool(xvfb, "key", "Escape")
         out, err = finish(proc)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     assert proc.returncode == 0 and "Traceback" not in err, err
     record = np.load(tmp_path / "run.npz")
     assert set(record.files) == set(TRAJECTORY_COLUMNS)
@@ -99,7 +85,7 @@ def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_
     steps = len(times) - 1  # the starting state, then one record per step
     assert steps > 100, steps
     assert f"recorded {steps} steps (5 balls) to run.npz" in out
-    simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
+    simulate(scene, steps, tmp_path / "sim.npz")
     assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
@@ -110,8 +96,7 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
     # untouched ``ballpit simulate`` of as many steps, bit for bit.
     scene = tmp_path / "slopes.toml"
     shutil.copy(default_scene_path(), scene)
-    proc, _ = open_viewer(xvfb, tmp_path, str(scene), "--record", "run.npz")
-    try:
+    with viewer(xvfb, tmp_path, str(scene), "--record", "run.npz") as proc:
         xdotool(xvfb, "key", "x")
         time.sleep(2.0)
         xdotool(xvfb, "key", "space")  # pause
@@ -126,16 +111,13 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
         time.sleep(0.3)
         xdotool(xvfb, "key", "Escape")
         _out, err = finish(proc)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     assert proc.returncode == 0 and "Traceback" not in err, err
     record = np.load(tmp_path / "run.npz")
     times = record["time"].reshape(-1, 5)[:, 0]  # five balls a record
     assert np.all(np.diff(times) > 0)  # no step twice, no jump back in time
     steps = len(times) - 1
     assert steps > 100, steps
-    simulate(scene, steps, tmp_path / "sim.npz", tmp_path)
+    simulate(scene, steps, tmp_path / "sim.npz")
     assert_same_trajectory(record, np.load(tmp_path / "sim.npz"))
 
 
@@ -143,17 +125,13 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
 def test_ctrl_c_writes_the_record_and_a_shot_ball_gets_the_next_id(xvfb, tmp_path):
     scene = tmp_path / "slopes.toml"
     shutil.copy(default_scene_path(), scene)
-    proc, _ = open_viewer(xvfb, tmp_path, str(scene), "--record", "run.csv")
-    try:
+    with viewer(xvfb, tmp_path, str(scene), "--record", "run.csv") as proc:
         xdotool(xvfb, "key", "x")
         time.sleep(0.8)
         xdotool(xvfb, "key", "b")
         time.sleep(0.8)
         proc.send_signal(signal.SIGINT)  # Ctrl+C in the terminal
         out, err = finish(proc)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err, err
     lines = (tmp_path / "run.csv").read_text().splitlines()
@@ -168,7 +146,7 @@ def test_ctrl_c_writes_the_record_and_a_shot_ball_gets_the_next_id(xvfb, tmp_pat
     steps = len(counts) - 1
     assert f"recorded {steps} steps (6 balls) to run.csv" in out
     # up to the shot, the same rows, to the character, as simulate writes
-    simulate(scene, first_six - 1, tmp_path / "sim.csv", tmp_path)
+    simulate(scene, first_six - 1, tmp_path / "sim.csv")
     expected = (tmp_path / "sim.csv").read_text().splitlines()
     assert lines[: len(expected)] == expected and len(expected) == 1 + 5 * first_six
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from .conftest import REPO, run_driver, subprocess_env
+from .conftest import REPO, ended, run_driver, started, subprocess_env, xdotool
 from .window_driver import GOOD_SCENE
 
 DRIVER = Path(__file__).with_name("window_driver.py")
@@ -36,6 +36,13 @@ BATCH = (
 
 def run_scenario(display: str, name: str, workdir: Path) -> dict:
     return run_driver(DRIVER, display, name, workdir, timeout=120, batch=BATCH)
+
+
+def pixels(png: str) -> np.ndarray:
+    """A screenshot the window wrote (F12), as an (H, W, 3) int array."""
+    from PIL import Image
+
+    return np.asarray(Image.open(png).convert("RGB")).astype(int)
 
 
 def test_the_title_shows_the_frame_rate(xvfb, tmp_path):
@@ -120,7 +127,7 @@ def test_the_slopes_demo_frames_its_action_clear_of_the_hud(xvfb, tmp_path):
     assert r["scene"] == "slopes.toml" and (width, height) == (1280, 720)
     left, top, right, bottom = r["hud"]
     # the featured top ball (purple, #9b5de5) is on screen from the first frame, not behind the HUD
-    first = np.array(r["first_frame"])
+    first = pixels(r["first_frame"])
     purple = (first[..., 2] > first[..., 0] + 40) & (first[..., 0] > first[..., 1] + 30)
     rows, cols = np.nonzero(purple)
     outside = ~((cols >= left) & (cols < right) & (rows >= top) & (rows < bottom))
@@ -170,7 +177,7 @@ def test_the_f1_help_never_covers_the_hud_panel(xvfb, tmp_path):
     # beside the ImGui panel the help's text shrinks to fit the 3-D view (950 px wide; 470 at 800x450)
     assert r["800x450 panel"]["left"] == 330 and r["800x450 panel"]["help"][2] <= 800
     # in the real pixels: the HUD's bright text shows in its panel, the gap between the panels is scene
-    image = np.array(r["1280x720"]["pixels"])
+    image = pixels(r["1280x720"]["pixels"])
     hud, help_ = (np.array(r["1280x720"][k], dtype=int) for k in ("hud", "help"))
     hud_pixels = image[hud[1] : hud[3], hud[0] : hud[2]]
     assert (hud_pixels.min(axis=-1) > 200).sum() > 200  # its text
@@ -192,29 +199,18 @@ def test_one_escape_asks_for_a_second_which_quits(xvfb, tmp_path):
 
 
 # ---------------------------------------------------------------------- the real event loop + X input
-def xdotool(display: str, *args: str) -> str:
-    out = subprocess.run(
-        ["xdotool", *args], env=subprocess_env(display), capture_output=True, text=True, timeout=20
-    )
-    return out.stdout.strip()
-
-
 @pytest.mark.skipif(shutil.which("xdotool") is None, reason="xdotool is not installed")
 def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_a_second_escape(xvfb, tmp_path):
     scene = tmp_path / "demo.toml"
     scene.write_text(GOOD_SCENE)
     code = "import sys, pathlib; from ballpit.viewer.app import run; sys.exit(run(pathlib.Path(sys.argv[1])))"
-    proc = subprocess.Popen(
-        [sys.executable, "-c", code, str(scene)], env=subprocess_env(xvfb), cwd=tmp_path,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    try:
+    with started([sys.executable, "-c", code, str(scene)], xvfb, tmp_path) as proc:
         window = ""
         deadline = time.monotonic() + 60
         while not window and time.monotonic() < deadline and proc.poll() is None:
             window = xdotool(xvfb, "search", "--name", "demo.toml").split("\n")[0]
             time.sleep(0.1)
-        assert window, f"the viewer window never appeared (exit status {proc.poll()})"
+        assert window, f"the viewer window never appeared: {ended(proc)}"
         name = ""
         deadline = time.monotonic() + 30
         while not re.search(r"[1-9]\d*\.\d FPS$", name) and time.monotonic() < deadline:
@@ -231,13 +227,7 @@ def test_the_app_runs_its_event_loop_takes_real_x_key_presses_and_quits_on_a_sec
         try:
             out, err = proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
-            proc.kill()
-            out, err = proc.communicate()
-            pytest.fail(f"the viewer did not quit on Escape; title {name!r}; stdout {out!r}; stderr {err!r}")
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+            pytest.fail(f"the viewer did not quit on Escape; title {name!r}; {ended(proc)}")
     assert proc.returncode == 0, err
     assert "Traceback" not in err, err
     shot = re.search(r"screenshot saved to (\S+\.png)", out)
