@@ -250,7 +250,9 @@ class PhysicsThread:
                 if not self._free or self._stopped:
                     continue
                 try:
-                    rewound = self._rewind or any(rewind for _, _, rewind in self._commands)
+                    # a copy made in one C call (the window's thread appends meanwhile: iterating the
+                    # deque itself would raise if an append came between two items)
+                    rewound = self._rewind or any(rewind for _, _, rewind in tuple(self._commands))
                     if rewound:
                         self._rewind_to_shown()
                     commands = self._apply_commands()
