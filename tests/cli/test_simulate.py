@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import signal
 from dataclasses import replace
 from pathlib import Path
 
@@ -114,3 +115,42 @@ def test_profile_prints_the_time_of_every_stage_and_the_counts_per_step(scene, c
     assert intervals >= 1.0
     taken_whole = int(re.search(rf"crowded (\d+)/{steps}", counts).group(1))
     assert (taken_whole > 0) == crowded, counts
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # the dropped exception
+def test_a_stop_signal_whose_exception_python_dropped_still_ends_the_run():
+    """A stop signal handled inside code whose exceptions Python ignores (here a weakref callback, as
+    importlib's module-lock one is) loses the handler's exception, and the handler has set the stop
+    signals to be ignored by then: the stepping loop raises the stop again at its next step."""
+    import gc
+    import weakref
+
+    import ballpit.cli as cli
+
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    world = ballpit.World()
+    world.add_sphere(position=(0, 1, 0), radius=0.1)
+    seen: list[int] = []
+    refs: list[weakref.ref] = []
+
+    class Token:
+        pass
+
+    def observe(w):
+        seen.append(1)
+        if len(seen) == 10:
+            token = Token()
+            refs.append(weakref.ref(token, lambda _: cli._on_stop_signal(signal.SIGTERM, None)))
+            del token  # the callback runs here; what it raises is printed and dropped
+            gc.collect()
+            assert cli._stopped_by == [signal.SIGTERM]  # the handler ran; its exception went nowhere
+
+    cli._stopped_by.clear()
+    try:
+        with pytest.raises(cli.Terminated):
+            run(world, 1.0, 0.01, observe=observe)
+    finally:
+        cli._stopped_by.clear()
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+    assert len(seen) == 10  # stopped at the step after the lost one, not at the run's end (101)

@@ -40,6 +40,17 @@ def _on_stop_signal(signum: int, frame: object) -> None:
     raise Terminated(signum)
 
 
+def raise_if_stopped() -> None:
+    """Raise the stop signal's exception again if one came and the run goes on.
+
+    The handler raises it in whatever Python code the main thread runs when the signal is handled. If
+    that is code whose exceptions Python ignores (a weakref callback such as importlib's module-lock
+    one, a finaliser: "Exception ignored in ..."), the stop is lost, and the later signals are ignored
+    by then, so a long run would go on to its end. The stepping loops call this once a step."""
+    if _stopped_by:
+        raise KeyboardInterrupt if _stopped_by[0] == signal.SIGINT else Terminated(_stopped_by[0])
+
+
 def _install_stop_handlers() -> dict[int, object]:
     """Route SIGINT, SIGTERM and SIGHUP to _on_stop_signal; returns the handlers they had."""
     previous: dict[int, object] = {}

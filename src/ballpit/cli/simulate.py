@@ -17,6 +17,7 @@ from tqdm import tqdm
 from ..physics import DEFAULT_TIMESTEP, Contacts, World
 from ..physics.core.contacts import SPHERE_PLANE, SPHERE_SPHERE
 from ..physics.core.validation import MAX_TIMESTEP
+from . import raise_if_stopped
 from .trajectory import TrajectoryWriter
 from .writers import EventWriter
 
@@ -234,6 +235,7 @@ def run(
     try:
         for n, h in plan:
             for _ in range(n):
+                raise_if_stopped()
                 began_at = world.time
                 contacts = world.step(h)
                 done += 1
