@@ -206,3 +206,21 @@ def test_unwritable_plot_folder_is_one_line(tmp_path):
     finally:
         if locked != Path("/sys"):
             locked.chmod(0o755)
+
+
+def test_a_stop_recorded_but_not_raised_ends_the_comparison_at_its_next_step():
+    """As simulate's loop does: a stop signal whose exception Python dropped (cli.raise_if_stopped)
+    is raised again by the stepping loop, not left to run every integrator to the end."""
+    import signal
+
+    import ballpit
+    import ballpit.cli as cli
+
+    world = ballpit.World()
+    world.add_sphere(position=(0, 1, 0), radius=0.1)
+    cli._stopped_by[:] = [signal.SIGTERM]
+    try:
+        with pytest.raises(cli.Terminated):
+            compare(world, 1.0, 0.01)
+    finally:
+        cli._stopped_by.clear()

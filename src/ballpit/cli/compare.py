@@ -20,6 +20,7 @@ from tqdm import tqdm
 
 from ..physics import World
 from ..physics.dynamics.integrators import DEFAULT_INTEGRATOR, INTEGRATOR_NAMES
+from . import raise_if_stopped
 from .energy_trace import EnergyRecorder, EnergyTrace
 from .simulate import progress_bar, step_longer_than_run, step_plan
 
@@ -120,6 +121,7 @@ def _run(
     steps = 0
     for n, h in step_plan(duration, dt):
         for _ in range(n):
+            raise_if_stopped()
             try:
                 world.step(h)
             except FloatingPointError as e:
