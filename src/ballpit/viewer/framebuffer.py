@@ -147,19 +147,17 @@ class WindowView:
         leaves that bound, with no scissor."""
         w, h = self.size
         left = self.left
-        if left:
-            GL.glScissor(left, 0, width - left, height)
         if self.target is not None:  # resolve the samples: into the texture, or straight into the window
             GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.target.fbo)
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._texture_fbo or destination)
-            if self._texture_fbo:  # the texture is as large as the view: its columns, not the window's
-                first = self._first_column(width)
+            if left:  # the columns drawn: the texture's own (as large as the view), else the window's
+                first = self._first_column(width) if self._texture_fbo else left
                 GL.glScissor(first, 0, w - first, h)
             GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
-            if self._texture_fbo and left:
-                GL.glScissor(left, 0, width - left, height)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, destination)
         GL.glViewport(0, 0, width, height)
+        if left:
+            GL.glScissor(left, 0, width - left, height)
         if self._texture is not None:
             GL.glDisable(GL.GL_DEPTH_TEST)
             GL.glDisable(GL.GL_BLEND)
