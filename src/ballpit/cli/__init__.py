@@ -35,9 +35,12 @@ def _on_stop_signal(signum: int, frame: object) -> None:
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_IGN)
     _stopped_by.append(signum)
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
-    raise Terminated(signum)
+    raise _stop_exception(signum)
+
+
+def _stop_exception(signum: int) -> BaseException:
+    """What a stop signal unwinds the run with: KeyboardInterrupt for Ctrl+C, else Terminated."""
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
 
 
 def raise_if_stopped() -> None:
@@ -48,7 +51,7 @@ def raise_if_stopped() -> None:
     one, a finaliser: "Exception ignored in ..."), the stop is lost, and the later signals are ignored
     by then, so a long run would go on to its end. The stepping loops call this once a step."""
     if _stopped_by:
-        raise KeyboardInterrupt if _stopped_by[0] == signal.SIGINT else Terminated(_stopped_by[0])
+        raise _stop_exception(_stopped_by[0])
 
 
 def _install_stop_handlers() -> dict[int, object]:
