@@ -149,16 +149,11 @@ class Panel:
         return 1e3 * float(np.mean(kept)) if kept else 0.0
 
     # ------------------------------------------------------------------ the frame
-    def draw(self, shown: Shown, rebuild: bool = True) -> None:
-        """Build the panel for ``shown`` and draw it; without ``rebuild``, draw its last build again
-        when no input came since (the window's frames while the physics is busy: pacing.py)."""
-        self.build(shown, rebuild)
-        self.render()
-
     def build(self, shown: Shown, rebuild: bool = True) -> None:
         """Lay the panel out for ``shown`` (ImGui's widgets, Python on the window's thread), for
         ``render`` to draw: the window builds it while the rasteriser draws the 3-D view. Without
-        ``rebuild`` and with no input since, the last build is kept."""
+        ``rebuild`` and with no input since, the last build is kept (the window's frames while the
+        physics is busy: pacing.py)."""
         started, cpu = time.perf_counter(), time.thread_time()
         self._rebuilt = rebuild or not self.backend.can_redraw()
         if self._rebuilt:
