@@ -230,27 +230,16 @@ def test_a_ball_above_a_slope_shades_the_slope_and_casts_no_second_shadow_throug
 def test_the_casters_written_out_for_the_scene_shade_as_a_program_written_for_sixteen(offscreen):
     """The plane and ball programs are compiled for the number of casting planes the scene has
     (casters.glsl's CASTERS): the picture is the one a program written out for all sixteen draws."""
-    from ballpit.viewer.shaders import Program
-
     sim = slope_scene(ball=True)
     renderer = offscreen.renderer
     drawn = offscreen.render(sim, CAMERA)
-    own = renderer.ball_program, renderer.plane_program
-    defines = {"CASTERS": renderer_module.MAX_CASTERS}
-    full = (
-        Program("ball.vert", "ball.frag", defines=defines),
-        Program("plane.vert", "plane.frag", defines=defines),
-    )
+    casters = len(renderer._caster_index)
+    assert casters < renderer_module.MAX_CASTERS
     try:
-        full[1].use()
-        full[1].set_int("u_shadow_balls", renderer_module.SHADOW_BALLS_UNIT)
-        full[1].set_int("u_shadow_cells", renderer_module.SHADOW_CELLS_UNIT)
-        renderer.ball_program, renderer.plane_program = full
+        renderer._programs_for(renderer_module.MAX_CASTERS)
         written_for_all = offscreen.draw(CAMERA)
     finally:
-        renderer.ball_program, renderer.plane_program = own
-        for program in full:
-            program.delete()
+        renderer._programs_for(casters)
     no_slope = brightness(offscreen.render(slope_scene(ball=False), CAMERA))
     assert (np.abs(no_slope - brightness(drawn)) > 100).any()  # the ball and its shadow are in it
     assert np.abs(drawn.astype(int) - written_for_all.astype(int)).max() <= 1
