@@ -119,8 +119,9 @@ class LeftOut:
         p, planes = self.pairs, len(self.pairs.sphere)
         on_plane, between = self.out[:planes], self.out[planes:]
         index = p.pair_i.dtype
-        kind = np.full(np.count_nonzero(on_plane) + np.count_nonzero(between), SPHERE_SPHERE, np.int8)
-        kind[: np.count_nonzero(on_plane)] = SPHERE_PLANE
+        plane_pairs = np.count_nonzero(on_plane)
+        kind = np.full(plane_pairs + np.count_nonzero(between), SPHERE_SPHERE, np.int8)
+        kind[:plane_pairs] = SPHERE_PLANE
         a = np.concatenate((p.sphere[on_plane], p.pair_i[between]), dtype=index)
         other = np.concatenate((p.plane[on_plane], p.pair_j[between]), dtype=index)
         return ContactPoints(kind, a, None, other, self.gap, None, None)
