@@ -95,31 +95,28 @@ class SoftFrame:
         self.whole: np.ndarray | None = None
         self.inv_mass: np.ndarray | None = None
 
-    def sweeps(
-        self,
-        target: np.ndarray,
-        count: int,
-        m_n: np.ndarray | None = None,
-        give: np.ndarray | None = None,
-        speeds: list[np.ndarray] | None = None,
-    ) -> None:
-        """``count`` Jacobi sweeps of the soft normal update towards ``target`` (``jacobi.sweeps``,
-        friction and rolling in the last), from the frame's impulses to its new ones; ``speeds``, if given,
-        holds the contacts' normal speeds now (the first sweep's: taken and used up). The sweeps take the old
-        impulses as scratch, and the frame lets go of them first, so that the old normal impulses go
-        after the first sweep instead of being held through the rest (K floats)."""
-        self.normal, self.tangential = jacobi.sweeps(
-            self.k,
-            self.vw,
-            self._handed_over(),
-            self.tangential,
-            target,
-            count,
-            friction_every=count,
-            m_n=m_n,
-            give=give,
-            speeds=speeds,
+    def sweeps(self, terms: list, count: int, speeds: list[np.ndarray] | None = None) -> None:
+        """``count`` Jacobi sweeps of the soft normal update (``jacobi.sweeps``, friction and rolling in
+        the last), from the frame's impulses to its new ones. ``terms`` holds the target and, for a soft
+        update, m_n and give (``jacobi.sweeps``): it is emptied, and they are let go once the last sweep
+        has found its changes, before it adds them to the balls (three K arrays fewer at the solve's
+        peak, when the caller holds them nowhere else). ``speeds``, if given, holds the contacts' normal
+        speeds now (the first sweep's: taken and used up). The sweeps take the old impulses as scratch,
+        and the frame lets go of them first, so that the old normal impulses go after the first sweep
+        instead of being held through the rest (K floats)."""
+        target, m_n, give = (*terms, None, None)[:3]
+        terms.clear()
+        k, vw = self.k, self.vw
+        normal, _ = jacobi.sweeps(
+            k, vw, self._handed_over(), None, target, count - 1, m_n=m_n, give=give, speeds=speeds
         )
+        motion = k.motion
+        new, _ = jacobi.full_changes(
+            k, vw, normal, self.tangential, target, motion, k.m_n if m_n is None else m_n, give, False
+        )
+        del target, m_n, give
+        self.tangential = jacobi.add_changes(k, vw, k.push, normal, self.tangential, motion)
+        self.normal = new
 
     def _handed_over(self) -> np.ndarray:
         """The normal impulses, no longer held by the frame."""

@@ -177,7 +177,9 @@ def solve(f: SoftFrame, i: int) -> None:
     del speculative
     give *= k.m_n
     give *= k.whole
-    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give, speeds=speeds)
+    terms = [target, m_n, give]  # the sweeps let go of them before the last adds its changes
+    del target, m_n, give
+    f.sweeps(terms, SOLVE_SWEEPS, speeds=speeds)
 
 
 def integrate_positions(f: SoftFrame) -> None:
@@ -210,7 +212,9 @@ def relax(f: SoftFrame, i: int) -> None:
     # the soft update with mass scale 1 and no give, ΔP = m_n·(target − v_n): m_n·1 is m_n, and a give
     # of 0·P takes nothing from a finite P (and P − 0 is P), so the split m_n alone, with no (K,) arrays
     # of m_n·1 and 0·m_n·(1/m_n)
-    f.sweeps(target, RELAX_SWEEPS)
+    terms = [target]
+    del target
+    f.sweeps(terms, RELAX_SWEEPS)
     f.total += f.normal
 
 
