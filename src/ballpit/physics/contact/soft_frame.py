@@ -41,8 +41,14 @@ class SoftFrame:
         self.c, self.dt = c, dt
         self.h = h = dt / substeps
         n_balls = model.spheres.count
+        # the frame's two (2, 3, K) impulse blocks made first, while the heap still has the room the
+        # previous frame's left whole (made after the rows and columns, they found no hole that fits)
+        kc = len(c)
+        self.tangential = np.zeros((2, 3, kc))
+        motion = np.empty((2, 3, kc))
         self.rows = contact_rows(model, state, c)
-        k = self.k = jacobi.ContactColumns(self.rows, split=False)  # each substep's solve splits
+        k = self.k = jacobi.ContactColumns(self.rows, split=False, motion=motion)  # each substep splits
+        del motion
         self.rows.forget_radii()  # the solve reads the arms' lengths (``k.ra``, ``k.rb``) alone
         if len(c) > SWEEP_CHUNK:  # and each ball's inverse mass and inertia (``k.inverse``)
             self.rows.forget_masses()
@@ -79,7 +85,6 @@ class SoftFrame:
         # are found again when needed (``keys``, ``came_with``, ``start_speeds``), not held through the
         # substeps (24 bytes a contact each)
         keys = c.keys()
-        self.tangential = np.zeros((2, 3, kc))
         at = warm.lookup(keys)
         self.normal = warm.impulses(keys, c.normal, h, self.tangential, at).normal
         self.apart = warm.apart_of(keys, at)
