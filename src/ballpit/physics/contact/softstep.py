@@ -272,14 +272,17 @@ def store_impulses(
     f.whole = f.k.whole
     f.inv_mass = f.k.inverse[0].copy()  # each ball's 1/m, as moving apart reads it
     f.k = None
+    # the warm start's sorted copies first, and the frame's (2, 3, K) block let go, before the undo
+    # copies the balls (104 bytes a ball): the copy then takes the block's room instead of more heap
+    tangential, f.tangential = f.tangential, None
+    f.kept_order = warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    del tangential, kept
     f.keep_start(before_write() if before_write is not None else None)
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T
     body[idx, W] = f.vw[3:, live].T
     body[idx, Q] = f.q
-    tangential = f.tangential
-    f.vw = f.q = f.tangential = None
-    f.kept_order = warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    f.vw = f.q = None
     # what moving apart reads of the rows: the bodies, the inverse masses and the planes' surfaces
     f.rows = replace(f.rows, **dict.fromkeys(_ROWS_DONE))
