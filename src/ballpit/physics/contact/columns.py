@@ -110,7 +110,10 @@ class ContactColumns(Ends):
         if pushing is None:
             share = self.share
         else:
-            counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
+            # each ball's pushing contacts counted at both ends: whole numbers, exact in any order (the
+            # sums of ones a count weighted by ``pushing`` made), with no 2K weights
+            counts = np.bincount(self.ends[:k][pushing], minlength=self.m).astype(float)
+            counts += np.bincount(self.ends[k:][pushing], minlength=self.m)
             share = np.maximum(counts, 1.0, out=counts)
         self.shares = share
         if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept
