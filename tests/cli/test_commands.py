@@ -564,6 +564,45 @@ def test_ctrl_c_during_render_to_a_frame_folder_leaves_no_frames(tmp_path):
     ]
 
 
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # the dropped exception
+def test_a_stop_signal_whose_exception_python_dropped_still_ends_a_render(tmp_path, monkeypatch):
+    """As in simulate's loop: a SIGTERM handled inside code whose exceptions Python ignores (a weakref
+    callback) loses its exception, and the stop signals are ignored from then on; the render's frame
+    loop raises the stop again at its next frame, and leaves no frames behind."""
+    import gc
+    import weakref
+
+    import ballpit.cli as cli
+    from ballpit.viewer.simulation import Simulation
+
+    advance, calls, refs = Simulation.advance, [], []
+
+    class Token:
+        pass
+
+    def advance_and_lose_a_stop(self, seconds):
+        calls.append(seconds)
+        if len(calls) == 5:
+            token = Token()
+            refs.append(weakref.ref(token, lambda _: cli._on_stop_signal(signal.SIGTERM, None)))
+            del token  # the handler runs here; what it raises is printed and dropped
+            gc.collect()
+        return advance(self, seconds)
+
+    monkeypatch.setattr(Simulation, "advance", advance_and_lose_a_stop)
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        out = tmp_path / "frames"
+        r = ballpit("render", "scenes/slopes.toml", "--out", f"{out}/", "--duration", "4", "--size", "32x32")
+    finally:
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+    assert r.returncode == 128 + signal.SIGTERM, r.stderr
+    assert "Traceback" not in r.stderr
+    assert len(calls) == 5  # stopped at the frame after the lost stop, not after 119 more
+    assert not out.exists()
+
+
 def test_render_makes_no_missing_folder_on_the_way_to_its_output_as_simulate_makes_none(tmp_path):
     # A mistyped --out once made a folder at the root of the file system.
     for out in ("missing/demo.gif", "missing/frame.png", "missing/frames/", "missing/deeper/frames/"):

@@ -15,6 +15,7 @@ from ballpit.viewer.pacing import (
     PACE_FAST,
     PACE_SLOW,
     PANEL_BUSY_HZ,
+    PANEL_HZ,
     SLOW_FPS,
     FramePacer,
 )
@@ -43,14 +44,18 @@ def test_the_slow_rate_keeps_the_30_fps_the_viewer_promises():
     assert 30.0 < SLOW_FPS < FAST_FPS and BUSY_FAST < BUSY_SLOW < 1.0 and PACE_FAST < PACE_SLOW
 
 
-def test_while_the_physics_is_busy_the_panel_is_built_ten_times_a_second_and_the_hud_four():
+def test_the_panel_is_built_twenty_times_a_second_at_ease_and_ten_while_the_physics_is_busy():
     pacer = FramePacer()
-    assert pacer.build_panel(0.0) and pacer.build_panel(0.001)  # at ease: every frame
+    at_ease = [t for t in (i / 60 for i in range(60)) if pacer.build_panel(t)]
+    assert len(at_ease) == PANEL_HZ == 20  # a second of 60 frames
+    assert pacer.build_panel(5.0) and pacer.build_panel(5.001, free=False)  # stepped by hand: every frame
     assert pacer.hud_interval() == HUD_INTERVAL
     pacer.interval(1.0)  # busy
     assert pacer.hud_interval() == HUD_BUSY_INTERVAL == 0.25
     built = [t for t in (i / 33 for i in range(33)) if pacer.build_panel(10.0 + t)]
     assert len(built) == PANEL_BUSY_HZ == 10  # a second of 33 frames
+    assert not pacer.build_panel(10.999, free=False)  # busy: by hand too
     plain = FramePacer(thrifty=False)
+    assert plain.build_panel(0.0) and plain.build_panel(0.001)
     plain.interval(1.0)
     assert plain.build_panel(0.0) and plain.build_panel(0.001) and plain.hud_interval() == HUD_INTERVAL

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .. import __version__
-from . import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
+from . import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, raise_if_stopped
 from .allocator import keep_freed_memory
 from .arguments import OneLineParser, one_line
 from .arguments import count as _count
@@ -359,7 +359,15 @@ def _render(args: argparse.Namespace) -> int:
     before = _render_files(out, folder)
     try:
         _check_writable(out if folder else out.parent, args.out)
-        written = render(path, out, duration=duration, fps=args.fps, size=args.size, progress=True)
+        written = render(
+            path,
+            out,
+            duration=duration,
+            fps=args.fps,
+            size=args.size,
+            progress=True,
+            each_frame=raise_if_stopped,
+        )
     except OSError as e:  # the disk filled, or the file could not be made at the end
         _remove_render_output(out, folder, before, created)
         raise OutputFailed(f"{args.out}: cannot write: {e.strerror or e}") from None

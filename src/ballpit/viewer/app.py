@@ -377,7 +377,7 @@ class Viewer:
         # the HUD's text and the panel are laid out while the rasteriser draws the view (renderer.draw
         # flushes it), then stretched into the window, with the HUD, the labels and the panel over it
         self._update_hud(now, shown)
-        self.panel.build(shown, rebuild=self.pacer.build_panel(now))
+        self.panel.build(shown, rebuild=self.pacer.build_panel(now, free=dt is None))
         view.finish(width, height)
         self.hud.draw(now)
         self.screen.draw_labels()

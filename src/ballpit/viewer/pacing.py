@@ -11,12 +11,15 @@ the CPU given back could not bring it near; and it goes back up once the physics
 Each pair of thresholds is apart so the rate does not flip every time they are measured. A GPU draws
 a frame in a fraction of a millisecond of CPU; there the physics rarely needs the slower rate.
 
-While the physics is busy the frames drawn cost less too: the panel is built with ImGui at most
-``PANEL_BUSY_HZ`` times a second (in between its last build is drawn again, unless input came) and the
-HUD's text and the timeline bar's label laid out again every ``HUD_BUSY_INTERVAL`` (pyglet lays the
-whole text out again whenever it changes: a few ms of the window's thread). That is work of the
-window's thread between frames that the physics does not get; the frames themselves are as many as
-before.
+The panel is built with ImGui at most ``PANEL_HZ`` times a second, ``PANEL_BUSY_HZ`` while the
+physics is busy, and at once when input comes; in between, its last build is drawn again from the GL
+buffers that hold it. Its live values and plots move at that rate, which reads as smooth, and the frames
+between do not pay the Python that lays ImGui's widgets out (0.6-0.8 ms of the window's thread on this
+machine): CPU that, on two cores, the ghosts' process and the physics need. While the physics is busy
+the HUD's text and the timeline bar's label are also laid out again only every ``HUD_BUSY_INTERVAL``
+(pyglet lays the whole text out again whenever it changes: a few ms of the window's thread). The frames
+themselves are as many as before. Frames stepped by hand (lockstep: tests, the offscreen renderer) build
+the panel every frame unless the physics is busy.
 
 No GL here: the window asks ``FramePacer.interval`` with the physics thread's busy share and pace.
 """
@@ -37,6 +40,7 @@ PACE_SLOW = 0.25
 PACE_FAST = 0.2
 HUD_INTERVAL = 0.1  # s between HUD text updates
 HUD_BUSY_INTERVAL = 0.25  # while the physics needs the CPU
+PANEL_HZ = 20.0  # panel builds a second at most, with no input
 PANEL_BUSY_HZ = 10.0  # panel builds a second at most while the physics needs the CPU
 
 
@@ -45,7 +49,7 @@ class FramePacer:
     """Chooses the time between frames from the physics thread's busy share and pace."""
 
     slow: bool = False
-    thrifty: bool = True  # while slow, the panel and the HUD's text are built less often
+    thrifty: bool = True  # the panel (and while slow the HUD's text) built less often than drawn
     _panel_at: float = 0.0
 
     def interval(self, busy: float, pace: float = 1.0) -> float:
@@ -62,10 +66,13 @@ class FramePacer:
         """Seconds until the HUD's text is laid out again."""
         return HUD_BUSY_INTERVAL if self.slow and self.thrifty else HUD_INTERVAL
 
-    def build_panel(self, now: float) -> bool:
-        """Whether the panel is built this frame (else its last build is drawn again)."""
-        step = 1.0 / PANEL_BUSY_HZ
-        if not (self.slow and self.thrifty) or now >= self._panel_at:
+    def build_panel(self, now: float, free: bool = True) -> bool:
+        """Whether the panel is built this frame (else its last build is drawn again). Not ``free``
+        (frames stepped by hand, lockstep), only the busy rate applies."""
+        if not (self.slow or free):
+            return True
+        step = 1.0 / (PANEL_BUSY_HZ if self.slow else PANEL_HZ)
+        if not self.thrifty or now >= self._panel_at:
             late = now - self._panel_at
             self._panel_at = (self._panel_at if late < step else now) + step  # from when it was due
             return True

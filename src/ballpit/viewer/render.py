@@ -13,7 +13,7 @@ import itertools
 import math
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -189,12 +189,15 @@ def render(
     fps: float = 30.0,
     size: tuple[int, int] = (800, 450),
     progress: bool = True,
+    each_frame: Callable[[], None] | None = None,
 ) -> Path:
     """Render the scene file's drop, starting at once, to ``out``; returns the path written."""
     from ballpit.scene import read_scene
 
     scene = read_scene(scene_path)
-    return render_world(scene, out, duration, fps, size, progress, scene_path=Path(scene_path))
+    return render_world(
+        scene, out, duration, fps, size, progress, scene_path=Path(scene_path), each_frame=each_frame
+    )
 
 
 def render_world(
@@ -206,8 +209,10 @@ def render_world(
     progress: bool = True,
     scene_path: Path | None = None,
     samples: int = 4,
+    each_frame: Callable[[], None] | None = None,
 ) -> Path:
-    """Render a Scene, or a World built in code, like ``render`` does."""
+    """Render a Scene, or a World built in code, like ``render`` does. ``each_frame`` is called before
+    every frame (the command line's check for a stop signal whose exception was lost)."""
     from PIL import Image
     from tqdm import tqdm
 
@@ -235,6 +240,8 @@ def render_world(
             range(frames), desc=f"rendering {look.name}", unit="frame", file=sys.stderr, disable=not progress
         )
         for index in bar:
+            if each_frame is not None:
+                each_frame()
             if index:
                 remaining = 1.0 / fps
                 while remaining > 1e-12:  # the accumulator takes at most 0.25 s per call
