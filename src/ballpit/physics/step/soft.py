@@ -14,7 +14,7 @@ from ..collision import geometry, narrowphase
 from ..collision.pairs import KeptPairs
 from ..contact import energy_guard, softstep
 from ..core import exact
-from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints, find_keys
+from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints, find_keys, take_indices
 from ..core.profile import Stage
 from ..core.settings import (
     BROAD_PHASE_STEPS,
@@ -79,21 +79,28 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < step.touching + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
-    c = contacts.subset(solved)
+    c = contacts.subset(solved, without=("normal", "point"))
     # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.ContactColumns.n is
-    # then this memory, not a copy of it)
-    c.normal = np.asfortranarray(c.normal)
+    # then this memory, not a copy of it), gathered a coordinate at a time (no (K, 3) copy on the way)
+    idx = take_indices(solved)
+    columns = np.empty((3, len(idx)))
+    for r, into in enumerate(columns):
+        into[:] = contacts.normal[idx, r]
+    c.normal = columns.T
+    del columns
+    # the points of the pairs between balls are made again for the record (``_points``), not held
+    # through the frame (24 bytes a contact), nor taken here; the rows of a moving plane read them.
+    # Every plane contact is solved, and they come first: ``contacts``' plane points are ``c``'s.
+    plane_points = None if model.moving_planes() else contacts.point[contacts.kind == SPHERE_PLANE]
+    if plane_points is None:
+        c.point = contacts.point.take(idx, axis=0)
+    del idx
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
     # them), and of the others, the pairs left out, only which bodies they join (found again from the
     # kept pairs, ``LeftOut``) and their gaps
     left = LeftOut(collision.pairs, ~solved, contacts.gap)
     del solved
     del contacts
-    # the points of the pairs between balls are made again for the record (``_points``), not held
-    # through the frame (24 bytes a contact); the rows of a moving plane read them
-    plane_points = None if model.moving_planes() else c.point[c.kind == SPHERE_PLANE]
-    if plane_points is not None:
-        c.point = None
     for substeps in [plan.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
