@@ -89,11 +89,12 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     c.normal = columns.T
     del columns
     # the points of the pairs between balls are made again for the record (``_points``), not held
-    # through the frame (24 bytes a contact), nor taken here; the rows of a moving plane read them.
-    # Every plane contact is solved, and they come first: ``contacts``' plane points are ``c``'s.
-    plane_points = None if model.moving_planes() else contacts.point[contacts.kind == SPHERE_PLANE]
-    if plane_points is None:
-        c.point = contacts.point.take(idx, axis=0)
+    # through the frame (24 bytes a contact); the rows of a moving plane read them (taken after the
+    # normals: the order the settled pile's peak RSS was measured with, docs/benchmarks.md)
+    c.point = contacts.point.take(idx, axis=0)
+    plane_points = None if model.moving_planes() else c.point[c.kind == SPHERE_PLANE]
+    if plane_points is not None:
+        c.point = None
     del idx
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
     # them), and of the others, the pairs left out, only which bodies they join (found again from the
