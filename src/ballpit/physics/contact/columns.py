@@ -22,9 +22,10 @@ class ContactColumns(Ends):
     cap, with their own effective masses and limits (zero limits where a material has none).
     """
 
-    def __init__(self, contacts: ContactRows, split: bool = True) -> None:
+    def __init__(self, contacts: ContactRows, split: bool = True, motion: np.ndarray | None = None) -> None:
         """The columns of ``contacts``, each ball's mass split among all its contacts (``split``; a
-        caller that splits before its first sweep, as a soft frame's solve does, says False)."""
+        caller that splits before its first sweep, as a soft frame's solve does, says False); ``motion``,
+        if given, is the (2, 3, K) scratch of a full sweep (made here otherwise)."""
         super().__init__(contacts.a, contacts.b)
         k, m = self.k, self.m
         ima, imb = contacts.inv_mass_a, contacts.inv_mass_b
@@ -56,7 +57,7 @@ class ContactColumns(Ends):
         # ADD_UP_BINS_UP_TO entries the pushes are made and added up one row at a time (``apply``), in
         # one row of scratch instead of six (80 bytes a contact less)
         self.push = np.empty((1 if 12 * k > ADD_UP_BINS_UP_TO else 6, 2 * k))
-        self.motion = np.empty((2, 3, k))
+        self.motion = np.empty((2, 3, k)) if motion is None else motion
         self.m_n: np.ndarray | None = None
         self.m_tr: np.ndarray | None = None
         if split:
@@ -109,7 +110,10 @@ class ContactColumns(Ends):
         if pushing is None:
             share = self.share
         else:
-            counts = np.bincount(self.ends, weights=np.concatenate((pushing, pushing)), minlength=self.m)
+            # each ball's pushing contacts counted at both ends: whole numbers, exact in any order (the
+            # sums of ones a count weighted by ``pushing`` made), with no 2K weights
+            counts = np.bincount(self.ends[:k][pushing], minlength=self.m).astype(float)
+            counts += np.bincount(self.ends[k:][pushing], minlength=self.m)
             share = np.maximum(counts, 1.0, out=counts)
         self.shares = share
         if k <= SWEEP_CHUNK:  # one chunk: m_t and m_r made here with m_n, once a split, and kept

@@ -226,6 +226,24 @@ def _full_sweep(
     (the new tangential impulses) and the changes into the old impulses' blocks, which then is the
     next sweep's ``motion``: two (2, 3, K) blocks, the old and new normal impulses, and the
     temporaries of one chunk."""
+    new, change = full_changes(c, vw, normal, tangential, target, motion, m_n, give, measure)
+    return new, add_changes(c, vw, push, normal, tangential, motion), change
+
+
+def full_changes(
+    c: ContactColumns,
+    vw: np.ndarray,
+    normal: np.ndarray,
+    tangential: np.ndarray,
+    target: np.ndarray,
+    motion: np.ndarray,
+    m_n: np.ndarray,
+    give: np.ndarray | float | None,
+    measure: bool,
+) -> tuple[np.ndarray, float]:
+    """The first half of ``_full_sweep``: the new normal impulses (returned), the new tangential
+    impulses into ``motion`` and the changes into the old ones' arrays, ``normal`` and ``tangential``,
+    none yet added to the balls (``add_changes``); with the largest velocity change (when ``measure``)."""
     k = c.k
     new = np.empty(k)
     d_n = normal  # each chunk's changes where its old impulses were, once read
@@ -234,9 +252,18 @@ def _full_sweep(
         part = slice(lo, min(lo + SWEEP_CHUNK, k))
         found = _full_chunk(c, vw, normal, tangential, target, motion, m_n, give, part, new, d_n, measure)
         change = max(change, found)
-    c.motion = tangential
-    apply(c, vw, push, d_n, tangential)
-    return new, motion, change
+    return new, change
+
+
+def add_changes(
+    c: ContactColumns, vw: np.ndarray, push: np.ndarray, d_n: np.ndarray, d_t: np.ndarray, motion: np.ndarray
+) -> np.ndarray:
+    """The second half of ``_full_sweep``: add the changes ``d_n`` and ``d_t`` (``full_changes``) to the
+    balls; ``d_t``'s block becomes the next full sweep's scratch. Returns the new tangential impulses
+    (``motion``)."""
+    c.motion = d_t
+    apply(c, vw, push, d_n, d_t)
+    return motion
 
 
 def _full_chunk(

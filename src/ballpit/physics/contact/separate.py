@@ -73,14 +73,19 @@ def move_apart(f: SoftFrame, model: Model, state: State) -> np.ndarray:
     del normals, made
     new = penetration.keep_sides_of_planes(model, state, body[:, X], pos[:-1])
     energy_guard.pay_for_lift(model, state, body[:, X], new)
-    moved = new - body[:, X]
-    ma, mb = with_static(moved)[c.a], with_static(moved)[c.b]
-    d = ma - mb
-    np.minimum(
-        f.least,
-        s + d[:, 0] * c.normal[:, 0] + d[:, 1] * c.normal[:, 1] + d[:, 2] * c.normal[:, 2],
-        out=f.least,
-    )
+    # s + n·(Δx_a − Δx_b), summed ((s + d₀n₀) + d₁n₁) + d₂n₂, a coordinate at a time: three (K,)
+    # arrays alive, not the moves of both ends as (K, 3) rows (216 bytes a ball at 100,000 balls)
+    moved = np.ascontiguousarray(with_static(new - body[:, X]).T)  # (3, N + 1)
+    least = None
+    for k, column in enumerate(moved):
+        term = np.take(column, c.a)
+        term -= np.take(column, c.b)
+        term *= c.normal[:, k]
+        if least is None:
+            least = np.add(s, term, out=term)
+        else:
+            least += term
+    np.minimum(f.least, least, out=f.least)
     body[:, X] = new
     return s
 

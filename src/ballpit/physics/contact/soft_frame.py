@@ -41,8 +41,14 @@ class SoftFrame:
         self.c, self.dt = c, dt
         self.h = h = dt / substeps
         n_balls = model.spheres.count
+        # the frame's two (2, 3, K) impulse blocks made first, while the heap still has the room the
+        # previous frame's left whole (made after the rows and columns, they found no hole that fits)
+        kc = len(c)
+        self.tangential = np.zeros((2, 3, kc))
+        motion = np.empty((2, 3, kc))
         self.rows = contact_rows(model, state, c)
-        k = self.k = jacobi.ContactColumns(self.rows, split=False)  # each substep's solve splits
+        k = self.k = jacobi.ContactColumns(self.rows, split=False, motion=motion)  # each substep splits
+        del motion
         self.rows.forget_radii()  # the solve reads the arms' lengths (``k.ra``, ``k.rb``) alone
         if len(c) > SWEEP_CHUNK:  # and each ball's inverse mass and inertia (``k.inverse``)
             self.rows.forget_masses()
@@ -79,7 +85,6 @@ class SoftFrame:
         # are found again when needed (``keys``, ``came_with``, ``start_speeds``), not held through the
         # substeps (24 bytes a contact each)
         keys = c.keys()
-        self.tangential = np.zeros((2, 3, kc))
         at = warm.lookup(keys)
         self.normal = warm.impulses(keys, c.normal, h, self.tangential, at).normal
         self.apart = warm.apart_of(keys, at)
@@ -95,31 +100,28 @@ class SoftFrame:
         self.whole: np.ndarray | None = None
         self.inv_mass: np.ndarray | None = None
 
-    def sweeps(
-        self,
-        target: np.ndarray,
-        count: int,
-        m_n: np.ndarray | None = None,
-        give: np.ndarray | None = None,
-        speeds: list[np.ndarray] | None = None,
-    ) -> None:
-        """``count`` Jacobi sweeps of the soft normal update towards ``target`` (``jacobi.sweeps``,
-        friction and rolling in the last), from the frame's impulses to its new ones; ``speeds``, if given,
-        holds the contacts' normal speeds now (the first sweep's: taken and used up). The sweeps take the old
-        impulses as scratch, and the frame lets go of them first, so that the old normal impulses go
-        after the first sweep instead of being held through the rest (K floats)."""
-        self.normal, self.tangential = jacobi.sweeps(
-            self.k,
-            self.vw,
-            self._handed_over(),
-            self.tangential,
-            target,
-            count,
-            friction_every=count,
-            m_n=m_n,
-            give=give,
-            speeds=speeds,
+    def sweeps(self, terms: list, count: int, speeds: list[np.ndarray] | None = None) -> None:
+        """``count`` Jacobi sweeps of the soft normal update (``jacobi.sweeps``, friction and rolling in
+        the last), from the frame's impulses to its new ones. ``terms`` holds the target and, for a soft
+        update, m_n and give (``jacobi.sweeps``): it is emptied, and they are let go once the last sweep
+        has found its changes, before it adds them to the balls (three K arrays fewer at the solve's
+        peak, when the caller holds them nowhere else). ``speeds``, if given, holds the contacts' normal
+        speeds now (the first sweep's: taken and used up). The sweeps take the old impulses as scratch,
+        and the frame lets go of them first, so that the old normal impulses go after the first sweep
+        instead of being held through the rest (K floats)."""
+        target, m_n, give = (*terms, None, None)[:3]
+        terms.clear()
+        k, vw = self.k, self.vw
+        normal, _ = jacobi.sweeps(
+            k, vw, self._handed_over(), None, target, count - 1, m_n=m_n, give=give, speeds=speeds
         )
+        motion = k.motion
+        new, _ = jacobi.full_changes(
+            k, vw, normal, self.tangential, target, motion, k.m_n if m_n is None else m_n, give, False
+        )
+        del target, m_n, give
+        self.tangential = jacobi.add_changes(k, vw, k.push, normal, self.tangential, motion)
+        self.normal = new
 
     def _handed_over(self) -> np.ndarray:
         """The normal impulses, no longer held by the frame."""

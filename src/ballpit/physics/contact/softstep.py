@@ -177,7 +177,9 @@ def solve(f: SoftFrame, i: int) -> None:
     del speculative
     give *= k.m_n
     give *= k.whole
-    f.sweeps(target, SOLVE_SWEEPS, m_n=m_n, give=give, speeds=speeds)
+    terms = [target, m_n, give]  # the sweeps let go of them before the last adds its changes
+    del target, m_n, give
+    f.sweeps(terms, SOLVE_SWEEPS, speeds=speeds)
 
 
 def integrate_positions(f: SoftFrame) -> None:
@@ -210,7 +212,9 @@ def relax(f: SoftFrame, i: int) -> None:
     # the soft update with mass scale 1 and no give, ΔP = m_n·(target − v_n): m_n·1 is m_n, and a give
     # of 0·P takes nothing from a finite P (and P − 0 is P), so the split m_n alone, with no (K,) arrays
     # of m_n·1 and 0·m_n·(1/m_n)
-    f.sweeps(target, RELAX_SWEEPS)
+    terms = [target]
+    del target
+    f.sweeps(terms, RELAX_SWEEPS)
     f.total += f.normal
 
 
@@ -268,14 +272,17 @@ def store_impulses(
     f.whole = f.k.whole
     f.inv_mass = f.k.inverse[0].copy()  # each ball's 1/m, as moving apart reads it
     f.k = None
+    # the warm start's sorted copies first, and the frame's (2, 3, K) block let go, before the undo
+    # copies the balls (104 bytes a ball): the copy then takes the block's room instead of more heap
+    tangential, f.tangential = f.tangential, None
+    f.kept_order = warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    del tangential, kept
     f.keep_start(before_write() if before_write is not None else None)
     body, idx, live = state.body, f.idx, f.live
     body[idx, X] = f.x[:, live].T
     body[idx, V] = f.vw[:3, live].T
     body[idx, W] = f.vw[3:, live].T
     body[idx, Q] = f.q
-    tangential = f.tangential
-    f.vw = f.q = f.tangential = None
-    f.kept_order = warm.keep(f.keys(), Impulses(kept, tangential[0].T, tangential[1].T), f.h)
+    f.vw = f.q = None
     # what moving apart reads of the rows: the bodies, the inverse masses and the planes' surfaces
     f.rows = replace(f.rows, **dict.fromkeys(_ROWS_DONE))

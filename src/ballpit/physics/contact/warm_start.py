@@ -86,8 +86,12 @@ class WarmStart:
         pairs ``keys`` are kept in (for ``keep_apart``)."""
         order = np.argsort(keys)
         self.keys = keys[order]
-        parts = (imp.normal, imp.friction, imp.rolling)
-        self.forces = Impulses(*(_divided(part[order], h) for part in parts))
+        # friction and rolling sorted into one (2, 3, K) block, the size of a frame's impulse blocks,
+        # so that the heap's room for one serves the other (the same values as sorting each)
+        tangential = np.empty((2, 3, len(order)))
+        for into, part in zip(tangential, (imp.friction, imp.rolling), strict=True):
+            np.take(part.T, order, axis=1, out=into)
+        self.forces = Impulses(_divided(imp.normal[order], h), *_divided(tangential, h).transpose(0, 2, 1))
         self.apart = np.zeros(len(keys))
         return order
 

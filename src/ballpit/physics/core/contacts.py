@@ -93,10 +93,11 @@ class ContactPoints:
     def __len__(self) -> int:
         return len(self.a)
 
-    def subset(self, mask: np.ndarray) -> ContactPoints:
-        """The contacts where ``mask`` holds (or at the indices ``mask``), in their order."""
+    def subset(self, mask: np.ndarray, without: tuple[str, ...] = ()) -> ContactPoints:
+        """The contacts where ``mask`` holds (or at the indices ``mask``), in their order; the fields
+        named in ``without`` left None (for a caller that takes them its own way)."""
         idx = take_indices(mask)
-        parts = [getattr(self, name) for name in _POINT_FIELDS]
+        parts = [None if name in without else getattr(self, name) for name in _POINT_FIELDS]
         return ContactPoints(*[None if v is None else v.take(idx, axis=0) for v in parts])
 
     def gaps(self) -> ContactPoints:

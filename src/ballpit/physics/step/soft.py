@@ -14,9 +14,16 @@ from ..collision import geometry, narrowphase
 from ..collision.pairs import KeptPairs
 from ..contact import energy_guard, softstep
 from ..core import exact
-from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints, find_keys
+from ..core.contacts import SPHERE_PLANE, SPHERE_SPHERE, ContactPoints, find_keys, take_indices
 from ..core.profile import Stage
-from ..core.settings import BROAD_PHASE_STEPS, DEEP_OVERLAP, RETRIES, SPECULATIVE_REACH, SUBSTEP_TRAVEL
+from ..core.settings import (
+    BROAD_PHASE_STEPS,
+    DEEP_OVERLAP,
+    RETRIES,
+    SPECULATIVE_REACH,
+    SUBSTEP_TRAVEL,
+    SWEEP_CHUNK,
+)
 from ..core.state import State, V, X
 from ..dynamics import moving_planes
 from ..dynamics.forces import forces_of, free_acceleration
@@ -72,21 +79,29 @@ def frames(step: Step, motion: Motion, collision: Collision, plan: Plan, checkpo
     reach = (speed[contacts.a] + speed[contacts.b] + (pull[contacts.a] + pull[contacts.b]) * dt) * dt
     solved = (contacts.gap < step.touching + SPECULATIVE_REACH * reach) | (contacts.kind == SPHERE_PLANE)
     del reach
-    c = contacts.subset(solved)
+    c = contacts.subset(solved, without=("normal", "point"))
     # the normals laid out as (3, K) columns, which is how the solve reads them (jacobi.ContactColumns.n is
-    # then this memory, not a copy of it)
-    c.normal = np.asfortranarray(c.normal)
+    # then this memory, not a copy of it), gathered a coordinate at a time (no (K, 3) copy on the way)
+    idx = take_indices(solved)
+    columns = np.empty((3, len(idx)))
+    for r, into in enumerate(columns):
+        into[:] = contacts.normal[idx, r]
+    c.normal = columns.T
+    del columns
+    # the points of the pairs between balls are made again for the record (``_points``), not held
+    # through the frame (24 bytes a contact); the rows of a moving plane read them (taken after the
+    # normals: the order the settled pile's peak RSS was measured with, docs/benchmarks.md)
+    c.point = contacts.point.take(idx, axis=0)
+    plane_points = None if model.moving_planes() else c.point[c.kind == SPHERE_PLANE]
+    if plane_points is not None:
+        c.point = None
+    del idx
     # the frame and its checks read the normals and points of the pairs it solves alone (``c`` has
     # them), and of the others, the pairs left out, only which bodies they join (found again from the
     # kept pairs, ``LeftOut``) and their gaps
     left = LeftOut(collision.pairs, ~solved, contacts.gap)
     del solved
     del contacts
-    # the points of the pairs between balls are made again for the record (``_points``), not held
-    # through the frame (24 bytes a contact); the rows of a moving plane read them
-    plane_points = None if model.moving_planes() else c.point[c.kind == SPHERE_PLANE]
-    if plane_points is not None:
-        c.point = None
     for substeps in [plan.substeps << k for k in range(RETRIES + 1)]:
         h = dt / substeps
         fast = speed * h + pull * h * h > SUBSTEP_TRAVEL * radius
@@ -272,12 +287,15 @@ def _gap_from(c: ContactPoints, before: np.ndarray, model: Model, state: State) 
 def _points(c: ContactPoints, plane_points: np.ndarray, before: np.ndarray, model: Model) -> np.ndarray:
     """The contacts' points as the narrow phase measured them from the balls ``before`` the frame: the
     plane contacts' as kept, each pair of balls' at the middle of its gap, x_j + n·(r_j + ½·gap), by the
-    same operations as ``geometry.sphere_sphere``."""
+    same operations as ``geometry.sphere_sphere``, SWEEP_CHUNK pairs at a time (the (chunk, 3)
+    temporaries of a chunk, not of every pair: 72 bytes a contact each)."""
     on_plane = c.kind == SPHERE_PLANE
     point = np.empty((len(c), 3))
     point[on_plane] = plane_points
-    pair = ~on_plane
-    j, gap = c.other[pair], c.gap[pair]
-    xj = before[:, X].take(j, axis=0)
-    point[pair] = xj + c.normal[pair] * (model.spheres.radius[j] + 0.5 * gap)[:, None]
+    pairs = np.flatnonzero(~on_plane)
+    for lo in range(0, len(pairs), SWEEP_CHUNK):
+        pair = pairs[lo : lo + SWEEP_CHUNK]
+        j, gap = c.other[pair], c.gap[pair]
+        xj = before[j, 0:3]
+        point[pair] = xj + c.normal[pair] * (model.spheres.radius[j] + 0.5 * gap)[:, None]
     return point
