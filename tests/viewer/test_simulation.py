@@ -137,6 +137,26 @@ def test_reset_restores_the_initial_state_and_waits_for_x_again():
     assert sim.world.integrator == "euler"  # the live choice survives a reset
 
 
+def test_the_real_time_factor_counts_no_time_spent_waiting_for_x_or_paused():
+    """A run fed real time steps at real time: its first reading after X, and after a pause, is 1, not
+    the share of a measuring window that also held the wait (0.4 s waited, then 0.1 s run: 0.2)."""
+    sim = Simulation(drifting_world(), step_budget=math.inf)
+    for _ in range(24):  # 0.4 s waiting for X
+        sim.advance(1 / 60)
+    sim.start()
+    for _ in range(32):  # 0.53 s: one measuring window (0.5 s) and a little
+        sim.advance(1 / 60)
+    assert sim.real_time_factor == pytest.approx(1.0, abs=0.02)
+    sim.toggle_pause()
+    for _ in range(24):  # 0.4 s paused
+        sim.advance(1 / 60)
+    sim.toggle_pause()
+    sim.real_time_factor = 0.0  # forget the reading before the pause: the next one is read anew
+    for _ in range(32):
+        sim.advance(1 / 60)
+    assert sim.real_time_factor == pytest.approx(1.0, abs=0.02)
+
+
 def test_time_scale_speeds_up_simulated_time():
     sim = Simulation(drifting_world(), step_budget=math.inf)
     sim.start()
