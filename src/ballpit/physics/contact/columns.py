@@ -66,22 +66,31 @@ class ContactColumns(Ends):
     @property
     def ima(self) -> np.ndarray:
         """Each contact's a's 1/m (read only)."""
-        return self._masses[0] if self._masses is not None else self.inverse[0].take(self.ends[: self.k])
+        return self._per_contact(0)
 
     @property
     def imb(self) -> np.ndarray:
         """Each contact's b's 1/m, 0 for a plane (read only)."""
-        return self._masses[1] if self._masses is not None else self.inverse[0].take(self.ends[self.k :])
+        return self._per_contact(1)
 
     @property
     def iia(self) -> np.ndarray:
         """Each contact's a's 1/I (read only)."""
-        return self._masses[2] if self._masses is not None else self.inverse[1].take(self.ends[: self.k])
+        return self._per_contact(2)
 
     @property
     def iib(self) -> np.ndarray:
         """Each contact's b's 1/I, 0 for a plane (read only)."""
-        return self._masses[3] if self._masses is not None else self.inverse[1].take(self.ends[self.k :])
+        return self._per_contact(3)
+
+    def _per_contact(self, which: int) -> np.ndarray:
+        """``ima``, ``imb``, ``iia`` or ``iib`` (``which`` 0 to 3): kept, or gathered from each ball's
+        (``inverse``: 1/m for 0 and 1, 1/I for 2 and 3; a's ends for even, b's for odd)."""
+        if self._masses is not None:
+            return self._masses[which]
+        k = self.k
+        ends = self.ends[k:] if which % 2 else self.ends[:k]
+        return self.inverse[which // 2].take(ends)
 
     def normal_speeds(self, v: np.ndarray) -> np.ndarray:
         """Each contact's v_n = (v_a − v_b)·n from the (≥3, M) velocities ``v`` (spin does not change it
