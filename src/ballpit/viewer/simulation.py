@@ -151,9 +151,7 @@ class Simulation:
         self.steps_total = 0
         self.steps_per_second = 0.0
         self.real_time_factor = 0.0
-        self._stats_wall = 0.0
-        self._stats_steps = 0
-        self._stats_sim = 0.0
+        self._restart_stats()
         self.profile = RunProfile()  # the steps of the last stats window, stage by stage
         self._profile = RunProfile()
         self._new_timeline()
@@ -495,9 +493,9 @@ class Simulation:
             self.contacts = Contacts.concatenate(contacts)
 
     def _restart_stats(self) -> None:
-        """The run starts or resumes: a new measuring window, with none of the wall time spent waiting
-        or paused in it. That time read as a slow run: 0.10 of real time right after X, which the HUD
-        showed for a second while the states computed ahead carried it."""
+        """A new measuring window: after each one, and when the run starts or resumes, so that none of
+        the wall time spent waiting or paused is in it. That time read as a slow run: 0.10 of real time
+        right after X, which the HUD showed for a second while the states computed ahead carried it."""
         self._stats_wall, self._stats_steps, self._stats_sim = 0.0, 0, 0.0
 
     def _update_stats(self, frame_seconds: float, steps: int) -> None:
@@ -505,9 +503,7 @@ class Simulation:
         if self._stats_wall >= STATS_WINDOW:
             self.steps_per_second = self._stats_steps / self._stats_wall
             self.real_time_factor = self._stats_sim / self._stats_wall
-            self._stats_wall = 0.0
-            self._stats_steps = 0
-            self._stats_sim = 0.0
+            self._restart_stats()
             if self._profile.steps:  # paused: keep showing the last window that stepped
                 self.profile, self._profile = self._profile, RunProfile()
 
