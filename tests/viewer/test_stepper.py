@@ -252,10 +252,12 @@ def test_a_record_closed_while_the_run_is_ahead_ends_at_the_state_the_window_sho
 def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_thread():
     """The lead, the switch interval and where the ghosts run."""
     defaults = {"lead": stepper.LEAD_SECONDS, "switch_interval": stepper.SWITCH_INTERVAL}
-    defaults["ghosts_apart"] = True
+    defaults |= {"ghosts_apart": True, "hold": True}
     assert stepper.tuning_from({}) == defaults
-    tuned = stepper.tuning_from({"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002", "BALLPIT_GHOSTS": "thread"})
-    assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False}
+    environ = {"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002", "BALLPIT_GHOSTS": "thread"}
+    environ["BALLPIT_HOLD"] = "0"
+    tuned = stepper.tuning_from(environ)
+    assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False, "hold": False}
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, **tuned)
     try:
@@ -264,3 +266,102 @@ def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_
         assert not sim.timeline.ghosts.remote  # stepped on the physics thread
     finally:
         physics.stop()
+
+
+def _held(physics: PhysicsThread) -> bool:
+    """The scene waits for X while the thread has stepped a lead of its drop."""
+    sim = physics.sim
+    return sim.held and sim.world.time >= physics.lead - 1e-9 and not physics._commands
+
+
+def test_a_waiting_scene_is_stepped_ahead_but_shown_at_its_first_state_until_x():
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim)
+    try:
+        physics.run_free()
+        assert wait_for(lambda: _held(physics))
+        time.sleep(0.1)
+        shown = physics.shown
+        assert sim.phase is Phase.WAITING  # what is asked before X sees it waiting
+        assert shown.time == 0.0 and shown.hud.state == Phase.WAITING.value
+        np.testing.assert_array_equal(shown.positions, line_of_balls(3).spheres.positions)
+        assert sim.world.time >= physics.lead - 1e-9  # its first half second stepped meanwhile
+    finally:
+        physics.stop()
+
+
+def test_x_shows_the_steps_taken_while_held_from_that_instant_bit_for_bit():
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim)
+    try:
+        physics.run_free()
+        assert wait_for(lambda: _held(physics))
+        stepped = sim.world.time
+        physics.submit(lambda s: s.start(), rewind=False)
+        pressed = time.perf_counter()
+        assert wait_for(lambda: physics.shown.time >= 0.2)
+        shown, wall = physics.shown, time.perf_counter() - pressed
+    finally:
+        physics.stop()
+    assert shown.time <= stepped  # one of the states stepped before X
+    assert shown.time == pytest.approx(wall, abs=0.05)  # shown from X at real speed
+    assert shown.hud.state == Phase.RUNNING.value and shown.message == "dropped"
+    fresh = line_of_balls(3)
+    while fresh.time < shown.time - 0.5 * sim.timestep:
+        fresh.step(sim.timestep)
+    np.testing.assert_array_equal(shown.positions, fresh.spheres.positions)
+
+
+def test_anything_asked_before_x_undoes_the_hold_and_finds_the_first_state_bit_for_bit(tmp_path):
+    from ballpit.viewer.recording import Recorder
+
+    sim = Simulation(line_of_balls(3))
+    recorder = Recorder(tmp_path / "run.npz", sim)
+    physics = PhysicsThread(sim)
+    seen = []
+    try:
+        physics.run_free()
+        assert wait_for(lambda: _held(physics))
+        assert recorder.steps > 0  # the held steps were recorded as they were taken
+        physics.submit(lambda s: seen.append((s.phase, s.world.time, s.timeline.history,
+                                              s.world.spheres.positions.copy(), recorder.steps)))  # fmt: skip
+        assert wait_for(lambda: seen)
+        physics.submit(lambda s: s.start())  # X after something else: the drop as it always was
+        assert wait_for(lambda: sim.world.time > 0.3)
+        physics.submit(lambda s: seen.append((s.world.time, s.world.spheres.positions.copy())))
+        assert wait_for(lambda: len(seen) == 2)
+    finally:
+        physics.stop()
+    phase, at, history, positions, steps = seen[0]
+    assert (phase, at, history, steps) == (Phase.WAITING, 0.0, None, 0)
+    np.testing.assert_array_equal(positions, line_of_balls(3).spheres.positions)
+    at, positions = seen[1]
+    fresh = line_of_balls(3)
+    while fresh.time < at - 0.5 * sim.timestep:
+        fresh.step(sim.timestep)
+    np.testing.assert_array_equal(positions, fresh.spheres.positions)
+
+
+@pytest.mark.slow
+def test_a_dear_start_is_shown_in_real_time_from_the_steps_taken_while_the_scene_waited_for_x():
+    # Its first 0.9 s cost 1.5x real time each. Held before X, the first half second is stepped while
+    # the scene waits; from X the thread needs 0.6 s for the other 0.4 s, shown in 0.9 s. Not held, the
+    # 0.9 s take 1.35 s from X, and the run is shown at 2/3 of real time.
+    speeds = {}
+    for hold in (True, False):
+        sim = Simulation(line_of_balls(3))
+        _cost(sim, 0.0, 0.9, 1.5)
+        physics = PhysicsThread(sim, hold=hold)
+        try:
+            physics.run_free()
+            if hold:
+                assert wait_for(lambda physics=physics: _held(physics))
+            else:
+                time.sleep(1.0)
+                assert sim.world.time == 0.0
+            physics.submit(lambda s: s.start(), rewind=False)
+            speeds[hold] = _shown_speed(physics, 0.9)
+        finally:
+            physics.stop()
+    assert speeds[True] == pytest.approx(1.0, abs=0.04), speeds
+    assert speeds[False] < 0.8, speeds

@@ -23,9 +23,9 @@ if TYPE_CHECKING:
 Handler = Callable[["Viewer"], None]
 
 
-def _command(fn: Callable) -> Handler:
+def _command(fn: Callable, rewind: bool = True) -> Handler:
     """An action that is one command to the physics side: ``fn(sim)``."""
-    return lambda v: v.command(fn)
+    return lambda v: v.command(fn, rewind=rewind)
 
 
 def _flip_flag(name: str) -> Handler:
@@ -84,7 +84,8 @@ def _panel(v: Viewer) -> None:
 
 
 HANDLERS: dict[Enum, Handler] = {
-    Action.START: _command(lambda sim: sim.start()),
+    # X reads nothing the steps change: it lets a run held before X go on (stepper.py) instead of undoing it
+    Action.START: _command(lambda sim: sim.start(), rewind=False),
     Action.PAUSE: _command(lambda sim: sim.toggle_pause()),
     Action.STEP: _command(lambda sim: sim.step_once()),
     Action.RESET: _command(lambda sim: sim.reset()),

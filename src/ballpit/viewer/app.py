@@ -110,6 +110,7 @@ class Viewer:
         self.traces = Traces()
         self.sim.after_step.append(lambda: self.traces.sample(self.sim))
         self.sim.after_reset.append(lambda: self.traces.follow(None))
+        self.sim.after_resume_from_past.append(lambda step: self.traces.cut(self.sim.world.time))
         tuning = tuning_from(os.environ)  # the one place the environment is read for it
         self.physics = PhysicsThread(self.sim, needs=self._needs, watch=self._watch, **tuning)
         self.panel = Panel(self)
@@ -234,9 +235,10 @@ class Viewer:
         """The latest state the physics handed over."""
         return self.physics.shown
 
-    def command(self, fn, then=None) -> None:
-        """Ask the physics side to run ``fn(sim)`` between steps (``then(result)`` back here after)."""
-        self.physics.submit(fn, then)
+    def command(self, fn, then=None, rewind: bool = True) -> None:
+        """Ask the physics side to run ``fn(sim)`` between steps (``then(result)`` back here after; see
+        ``PhysicsThread.submit`` for ``rewind``)."""
+        self.physics.submit(fn, then, rewind)
 
     # ------------------------------------------------------------------ actions
     def perform(self, action: Action) -> None:
@@ -314,7 +316,8 @@ class Viewer:
         if self.recorder is not None and not self.recorder.finished:
             shown, sim = self.physics.shown, self.sim
             ahead = sim.phase is Phase.RUNNING and shown.generation == sim.generation  # may have run ahead
-            finished = self.recorder.finish(shown.step if ahead else None)
+            # held before X: the steps taken meanwhile were never shown
+            finished = self.recorder.finish(0 if sim.held else shown.step if ahead else None)
             if finished is not None:
                 path, steps, balls = finished
                 print(f"recorded {steps} steps ({balls} balls) to {path}", flush=True)

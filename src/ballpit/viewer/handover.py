@@ -56,8 +56,9 @@ class HudFacts:
         from .simulation import Phase
 
         world = sim.world
-        state = sim.phase.value
-        if sim.phase is Phase.RUNNING and sim.time_scale != 1.0:
+        phase = sim.shown_phase
+        state = phase.value
+        if phase is Phase.RUNNING and sim.time_scale != 1.0:
             state = f"running at ×{sim.time_scale:g}"
         return cls(
             name=sim.appearance.name,
@@ -73,7 +74,7 @@ class HudFacts:
             state=state,
             timeline=timeline_lines(sim),
             profile=profile_body(sim),
-            running=sim.phase is Phase.RUNNING,
+            running=phase is Phase.RUNNING,
         )
 
 

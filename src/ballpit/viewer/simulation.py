@@ -138,6 +138,8 @@ class Simulation:
         spheres = self.world.spheres
         self.appearance.sphere_colors = self.appearance.sphere_colors[: len(spheres)]  # drop added balls
         self.phase = Phase.WAITING
+        self.held = False  # dropped but held at its first state until X (``hold``)
+        self._held_message = ""
         self.accumulator = 0.0
         self.alpha = 1.0
         self.prev_positions = np.array(spheres.positions, dtype=float)
@@ -214,14 +216,53 @@ class Simulation:
         return len(self.world.spheres)
 
     # ------------------------------------------------------------------ controls
+    @property
+    def shown_phase(self) -> Phase:
+        """The phase a state captured now is shown in: running for the steps taken while held before X
+        (they are shown after it), else the phase."""
+        return Phase.RUNNING if self.held else self.phase
+
     def start(self) -> None:
-        """X: start the drop (only from the waiting state)."""
+        """X: start the drop (only from the waiting state), or let a held one go on from its first state."""
+        if self.held:
+            self.held, self.phase = False, Phase.RUNNING
+            self._restart_stats()
+            self.message = "dropped"
+            return
         if self.phase is Phase.WAITING:
             self.phase = Phase.RUNNING
             self.accumulator = 0.0
             self._restart_stats()
             self.message = "dropped"
             self.timeline.started()
+
+    def hold(self) -> bool:
+        """Start the drop, but held at its first state until X: the physics thread steps its first second
+        ahead while the scene waits (stepper.py, "Held before X"), and X lets it go on from there. The
+        phase stays WAITING, so everything else asked before X sees the run waiting; it undoes the hold
+        first (``unhold``). False when there is nothing to hold (not waiting, or a replay)."""
+        if self.phase is not Phase.WAITING or self.held or self.timeline.replay is not None:
+            return False
+        self.timeline.started()
+        self.held, self._held_message = True, self.message
+        self.message = "dropped"  # what the states stepped meanwhile say when they are shown, after X
+        self.accumulator = 0.0
+        self._restart_stats()
+        return True
+
+    def unhold(self) -> None:
+        """Undo a hold: the world goes back to the drop's first state (its snapshot, bit for bit) and
+        waits for X as if it had never started. The steps taken meanwhile are forgotten, and what kept
+        them (the recording, the traces) hears of it as of a resume from step 0."""
+        if not self.held:
+            return
+        self.held = False
+        self.timeline.seek(0)
+        for hook in self.after_resume_from_past:
+            hook(0)
+        self.message = self._held_message
+        self._new_timeline()  # no history before X; ghosts, if on, wait for X again
+        self._restart_stats()
 
     def toggle_pause(self) -> None:
         """Space: pause a running simulation or resume a paused one."""
@@ -345,7 +386,7 @@ class Simulation:
         the time stepped. Returns the steps taken."""
         taken, stepped = 0, self._stats_sim
         contacts: list = []
-        while taken < steps and self.phase is Phase.RUNNING:
+        while taken < steps and (self.phase is Phase.RUNNING or self.held):
             self._step(contacts)
             taken += 1
         self._finish_steps(contacts)
@@ -374,7 +415,7 @@ class Simulation:
         try:
             result = self.timeline.step(self.timestep)
         except Exception as exc:  # a physics failure pauses the viewer instead of killing it
-            self.phase = Phase.PAUSED
+            self.phase, self.held = Phase.PAUSED, False
             self.error = f"physics step failed: {_describe(exc)}"
             print(f"ballpit: {self.error}", file=sys.stderr, flush=True)
             return

@@ -34,6 +34,20 @@ is answered from the state it shows: the steps taken ahead are dropped first, th
 the step shown (``History.mark`` keeps a snapshot of each step queued ahead, so that is one restore),
 and the run goes on from there, as resuming from the past does.
 
+Held before X. While a scene waits for X and nothing is asked of the thread (for ``HOLD_QUIET``),
+the drop is started but held at its first state (``Simulation.hold``): the thread steps up to ``lead``
+of it, as it runs ahead after X, and queues the states without a due time, while the window goes on
+showing the first one. X lets it go (``Simulation.start``, a command that does not rewind): the
+queued states get their due times from that instant, so the run starts with its lead already taken
+instead of building it meanwhile. pile.toml's landing costs more than the physics thread gets beside
+the window; from a lead built during its 0.6 s fall it was shown at 0.76-0.99 of real time. Anything
+else asked before X undoes the hold first (``Simulation.unhold``: the world back at its first state,
+bit for bit, waiting as before), then is done; the hold starts again once the thread is left alone.
+The integrator ghosts, if on, start with the hold too, so their process steps its first seconds
+before X instead of beside the landing. Scenes of more than ``HOLD_MAX_BALLS`` balls are not held
+(a batch of their steps would keep the window's commands waiting), and a hold stops after
+``HOLD_SECONDS`` of stepping.
+
 A thread rather than a process. First by benchmarks/physics_beside_drawing.py on a 2-core machine
 with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s with
 the physics on a thread against 8.3 and 10.1 in a process (physics 18 and 16 steps/s against 17 and
@@ -60,6 +74,7 @@ process had the landing shown at 0.92-1.00 of real time against 0.36-0.58 (docs/
 
 from __future__ import annotations
 
+import math
 import sys
 import threading
 import time
@@ -83,15 +98,20 @@ LEAD_FRAME = 1.0 / 60.0
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = 0.001
 GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach the main run's step
+HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
+HOLD_SECONDS = 2.0  # s of wall time a hold steps at most
+HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
 
 
 def tuning_from(environ: Mapping[str, str]) -> dict[str, Any]:
     """The thread's tuning as a benchmark sets it in the environment (read by the viewer when it starts
     the thread, and passed in): ``BALLPIT_LEAD`` (s; 0 holds the physics to the wall clock),
     ``BALLPIT_SWITCH`` (s), each LEAD_SECONDS and SWITCH_INTERVAL when not set, and ``BALLPIT_GHOSTS``
-    (``process``, the default, or ``thread``: the integrator ghosts stepped on this thread)."""
+    (``process``, the default, or ``thread``: the integrator ghosts stepped on this thread) and
+    ``BALLPIT_HOLD`` (``0``: no hold before X)."""
     return {
         "lead": float(environ.get("BALLPIT_LEAD", LEAD_SECONDS)),
+        "hold": environ.get("BALLPIT_HOLD", "1") != "0",
         "switch_interval": float(environ.get("BALLPIT_SWITCH", SWITCH_INTERVAL)),
         "ghosts_apart": environ.get("BALLPIT_GHOSTS", "process") != "thread",
     }
@@ -112,8 +132,10 @@ class PhysicsThread:
         lead: float = LEAD_SECONDS,
         switch_interval: float = SWITCH_INTERVAL,
         ghosts_apart: bool = False,
+        hold: bool = True,
     ) -> None:
         self.sim = sim
+        self.hold = hold  # a waiting scene is held, its first second stepped before X
         if ghosts_apart:  # the integrator ghosts' worlds in a process of their own (ghostproc.py)
             sim.ghosts_apart()
         self.lead = lead  # s of wall time the run may be stepped ahead of what the window shows
@@ -126,6 +148,9 @@ class PhysicsThread:
         self._base: tuple[float, float] | None = None  # (wall, simulated) times that map to each other
         self._counted = (0.0, 0.0)  # (wall, simulated time shown) when the factor was last fed
         self._rewind = False  # the window asked for the state it shows (what it draws changed)
+        self._holding = False  # the Simulation is held before X by this thread
+        self._held_seconds = 0.0  # wall s the hold has stepped
+        self._asked_at = time.perf_counter()  # when a command last came
         self._results: deque[tuple[Then, Any]] = deque()
         self._wake = threading.Event()
         self._free = False
@@ -167,12 +192,14 @@ class PhysicsThread:
         With ``rewind`` (the default) the command acts on the state the window shows: steps taken
         ahead of it are dropped first. Only what reads nothing the steps change may pass False."""
         self._commands.append((command, then, rewind))
+        self._asked_at = time.perf_counter()
         self._wake.set()
 
     def show_again(self) -> None:
         """What the window draws changed (an overlay on or off): hand the shown state over again, with
         it, instead of the states already captured ahead without it."""
         self._rewind = True
+        self._asked_at = time.perf_counter()
         self._wake.set()
 
     def run_free(self) -> None:
@@ -198,6 +225,8 @@ class PhysicsThread:
     def sync(self) -> None:
         """Apply the pending commands now, waiting for a step in progress (tests and scripted runs)."""
         with self.lock:
+            if self.sim.held:
+                self._rewind_to_shown()
             self._apply_commands()
             self.sim.timeline.settle_ghosts(GHOST_WAIT)
             self._publish(force_hud=True)
@@ -256,10 +285,14 @@ class PhysicsThread:
                     if rewound:
                         self._rewind_to_shown()
                     commands = self._apply_commands()
+                    if self._holding and not self.sim.held:
+                        self._released()  # X: the states stepped while held are due from now
                     now = time.perf_counter()
                     if self._restart_clock:
                         self._restart_clock, last = False, now
                     ahead_wait = None
+                    if self._may_hold(now):
+                        self._start_hold()
                     if self._may_run_ahead():
                         if rewound and commands:
                             self._publish(force_hud=True)  # what the commands did, shown at once
@@ -328,7 +361,7 @@ class PhysicsThread:
         timeline = sim.timeline
         return (
             self.lead > 0.0
-            and sim.phase is Phase.RUNNING
+            and (sim.phase is Phase.RUNNING or sim.held)
             and timeline.history is not None
             and timeline.replay is None
         )
@@ -340,32 +373,82 @@ class PhysicsThread:
         history = sim.timeline.history
         scale = max(sim.time_scale, 1e-9)
         now = time.perf_counter()
+        held = sim.held  # nothing is due before X: the window shows the first state
         if self._base is None:  # the window shows the present: time what comes from here
-            self._base = (now, sim.world.time)
+            self._base = (math.inf if held else now, sim.world.time)
             self._counted = (now, sim.world.time)
             history.mark()
         wall0, sim0 = self._base
-        shown = min(sim0 + (now - wall0) * scale, sim.world.time)  # the simulated time shown now
+        # the simulated time shown now
+        shown = sim0 if held else min(sim0 + (now - wall0) * scale, sim.world.time)
         ahead = (sim.world.time - shown) / scale
+        if held and self._held_seconds >= HOLD_SECONDS:
+            return IDLE_WAIT
         if ahead >= self.lead:
+            if held:
+                return IDLE_WAIT
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
         state = self._capture(force_hud=False)
         done = time.perf_counter()
-        due = wall0 + (state.time - sim0) / scale
+        due = wall0 + (state.time - sim0) / scale  # never, while held
         if due <= done:  # behind: the window waits for this state: shown now, the rest timed from it
             self._base, due = (done, state.time), done
         else:  # ahead: a command may come back to it
             history.mark()
-        wall0, sim0 = self._base
-        self._count_shown(done, min(sim0 + (done - wall0) * scale, state.time))
+        if held:
+            self._held_seconds += done - now
+        else:
+            wall0, sim0 = self._base
+            self._count_shown(done, min(sim0 + (done - wall0) * scale, state.time))
         with self._handover_lock:
             self._ahead.append((due, state))
             step = self._take_due(done).step
         if step is not None:
             history.unmark_before(step)
         return 0.0
+
+    # ------------------------------------------------------------------ held before X
+    def _may_hold(self, now: float) -> bool:
+        """A scene waits for X and nothing was asked for a while: its drop may be held (see "Held
+        before X")."""
+        sim = self.sim
+        return (
+            self.hold
+            and self.lead > 0.0
+            and sim.phase is Phase.WAITING
+            and not sim.held
+            and sim.timeline.replay is None
+            and sim.ball_count <= HOLD_MAX_BALLS
+            and not self._commands
+            and now - self._asked_at >= HOLD_QUIET
+        )
+
+    def _start_hold(self) -> None:
+        """Hold the drop: the state shown now is its first (step 0 of the history it starts)."""
+        if not self.sim.hold():
+            return
+        self._holding, self._held_seconds, self._base = True, 0.0, None
+        self._hud_at = 0.0  # the states stepped now are shown running: read the HUD's facts afresh
+        with self._handover_lock:
+            if self._shown.generation == self.sim.generation:
+                self._shown.step = 0  # it is: nothing changed the world since it was captured
+
+    def _released(self) -> None:
+        """X let the held run go (or a reset or reload dropped it): the states stepped meanwhile are due
+        from now, each at its simulated time from the first."""
+        self._holding = False
+        sim = self.sim
+        if self._base is None or sim.phase is not Phase.RUNNING:
+            self._base = None
+            return
+        now, sim0 = time.perf_counter(), self._base[1]
+        scale = max(sim.time_scale, 1e-9)
+        self._base = self._counted = (now, sim0)
+        with self._handover_lock:
+            timed = [(now + (state.time - sim0) / scale, state) for _, state in self._ahead]
+            self._ahead = deque(state for state in timed if state[1].generation == sim.generation)
 
     def _count_shown(self, now: float, shown: float) -> None:
         """The window's state had reached simulated time ``shown`` at wall time ``now``: the speed it is
@@ -386,7 +469,10 @@ class PhysicsThread:
         sim = self.sim
         history = sim.timeline.history
         step = shown.step if shown.generation == sim.generation else None
-        if queued and history is not None and step is not None and step < history.current:
+        if sim.held:  # before X: back to waiting at the first state
+            sim.unhold()
+            self._holding, asked = False, True
+        elif queued and history is not None and step is not None and step < history.current:
             sim.timeline.seek(step)
             sim.resume_from_here()
             asked = True

@@ -106,6 +106,11 @@ class Traces:
             self.ball = ball
             self.samples.clear()
 
+    def cut(self, time: float) -> None:
+        """The run goes on from ``time`` (s): the samples after it go (they were of a future dropped)."""
+        while self.samples and self.samples[-1][0] > time:
+            self.samples.pop()
+
     def sample(self, sim: Simulation) -> None:
         t = float(sim.world.time)
         while self.samples and self.samples[-1][0] >= t:  # stepped back, then on: the old future goes
@@ -132,7 +137,7 @@ def world_facts(sim: Simulation) -> WorldFacts:
     return WorldFacts(
         name=sim.appearance.name,
         path=sim.path,
-        phase=sim.phase,
+        phase=sim.shown_phase,
         time=float(world.time),
         time_scale=sim.time_scale,
         integrator=world.integrator,
