@@ -34,6 +34,22 @@ def test_the_window_keeps_drawing_while_the_1200_ball_pile_lands(xvfb, tmp_path)
     assert 0.0 < factor <= 1.0 + carried and factor <= r["last_second_factor"] + 0.25, r
 
 
+def test_a_scene_waiting_for_x_is_shown_still_while_its_drop_is_stepped_and_x_shows_it_at_once(
+    xvfb, tmp_path
+):
+    r = run_driver(DRIVER, xvfb, "held_drop", tmp_path, timeout=120)
+    before, after = r["before"], r["after"]
+    assert before["held"] and before["stepped"] >= 0.99, r  # its first second stepped while waiting
+    assert before["shown"] == 0.0 and before["moved"] == 0.0, r  # and not shown
+    assert "waiting: press X" in before["hud"] and before["prompt"] == "WAITING", r
+    assert after["phase"] == "RUNNING" and 0.3 <= after["shown"] <= 0.5, r  # shown from X on
+    # the HUD's facts of the states stepped while held were read every 0.1 s of their simulated time
+    # (every 0.1 s of wall time, they had been read twice in the second stepped, and said 0.017 s)
+    assert after["shown"] - 0.25 <= after["hud_time"] <= after["shown"], r
+    # the HUD's factor is read live: the states stepped while held carry none (0 when they were stepped)
+    assert after["stepped_factor"] == 0.0 and after["factor"] >= 0.8, r
+
+
 def test_esc_esc_closes_the_window_in_the_middle_of_a_10000_ball_step(xvfb, tmp_path):
     r = run_driver(DRIVER, xvfb, "escape_mid_step", tmp_path, timeout=240)
     assert r["stepping_at_escape"] and r["closed"]

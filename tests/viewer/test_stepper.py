@@ -285,7 +285,7 @@ def test_a_waiting_scene_is_stepped_ahead_but_shown_at_its_first_state_until_x()
         assert sim.phase is Phase.WAITING  # what is asked before X sees it waiting
         assert shown.time == 0.0 and shown.hud.state == Phase.WAITING.value
         np.testing.assert_array_equal(shown.positions, line_of_balls(3).spheres.positions)
-        assert sim.world.time >= physics.lead - 1e-9  # its first half second stepped meanwhile
+        assert sim.world.time >= physics.lead - 1e-9  # its first second stepped meanwhile
     finally:
         physics.stop()
 
@@ -344,9 +344,9 @@ def test_anything_asked_before_x_undoes_the_hold_and_finds_the_first_state_bit_f
 
 @pytest.mark.slow
 def test_a_dear_start_is_shown_in_real_time_from_the_steps_taken_while_the_scene_waited_for_x():
-    # Its first 0.9 s cost 1.5x real time each. Held before X, the first half second is stepped while
-    # the scene waits; from X the thread needs 0.6 s for the other 0.4 s, shown in 0.9 s. Not held, the
-    # 0.9 s take 1.35 s from X, and the run is shown at 2/3 of real time.
+    # Its first 0.9 s cost 1.5x real time each. Held before X, the first second is stepped while the
+    # scene waits, and shown from X in real time. Not held, the 0.9 s take 1.35 s from X, and the run
+    # is shown at 2/3 of real time.
     speeds = {}
     for hold in (True, False):
         sim = Simulation(line_of_balls(3))

@@ -481,6 +481,32 @@ def pile_landing(workdir: Path) -> dict:
     return _drop_and_land(_bundled_viewer("pile.toml"), 4.0)
 
 
+def held_drop(workdir: Path) -> dict:
+    """slopes.toml waiting for X until its drop is held (its first second stepped), then X: what the
+    window showed before, and the HUD's real-time factor and the state shown 0.4 s after."""
+    import re
+
+    from pyglet.window import key
+
+    viewer = _bundled_viewer("slopes.toml")
+    physics, sim = viewer.physics, viewer.sim
+    first = np.array(sim.world.spheres.positions)
+    pump_until(viewer, lambda: sim.held and sim.world.time >= physics.lead - 1e-9, timeout=30)
+    pump_for(viewer, 0.2)
+    before = {"held": sim.held, "stepped": sim.world.time, "shown": physics.shown.time,
+              "moved": float(np.abs(physics.shown.positions - first).max()),
+              "hud": viewer.hud.text, "prompt": physics.shown.watch.world.phase.name}  # fmt: skip
+    viewer.window.dispatch_event("on_key_press", key.X, 0)
+    pump_for(viewer, 0.4)
+    shown = physics.shown
+    factor = float(re.search(r"real-time factor (\d\.\d\d)", viewer.hud.text).group(1))
+    hud_time = float(re.search(r"sim time +(\d+\.\d+) s", viewer.hud.text).group(1))
+    after = {"shown": shown.time, "factor": factor, "stepped_factor": shown.hud.real_time_factor,
+             "hud_time": hud_time,
+             "hud": viewer.hud.text, "phase": sim.phase.name}  # fmt: skip
+    return {"before": before, "after": after}
+
+
 def view_reuse(workdir: Path) -> dict:
     """Waiting for X with nothing moving, then flying: frames shown against 3-D views drawn."""
     viewer = open_viewer(world=balls_world())
@@ -596,6 +622,7 @@ SCENARIOS = {
     for f in (
         title,
         drop,
+        held_drop,
         fly,
         pause_step_reset,
         broken_reload,

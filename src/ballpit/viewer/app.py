@@ -438,13 +438,14 @@ class Viewer:
             self.hud.layout()
         if now >= self._hud_at and shown.hud is not None:
             self._hud_at = now + self.pacer.hud_interval()
+            facts = self.physics.live_rates(shown)
             if self.hud.page == "profile":
                 drawn = [f"renderer    {self.renderer_name}", f"quality     {self.quality.describe()} (F3)",
                          f"drawing     {self.pacer.describe()}"]  # fmt: skip
-                self.hud.set_text(profile_lines(shown.hud, drawn))
+                self.hud.set_text(profile_lines(facts, drawn))
             else:
                 extra, shot = self.interaction.hud_lines(), self.interaction.shot_speed
-                self.hud.set_text(hud_lines(shown.hud, self.camera.speed, self._overlay_names(), extra, shot))
+                self.hud.set_text(hud_lines(facts, self.camera.speed, self._overlay_names(), extra, shot))
             self.hud.set_error(shown.error)
         if shown.message != self._shown_message:
             self._shown_message = shown.message

@@ -35,8 +35,8 @@ the step shown (``History.mark`` keeps a snapshot of each step queued ahead, so 
 and the run goes on from there, as resuming from the past does.
 
 Held before X. While a scene waits for X and nothing is asked of the thread (for ``HOLD_QUIET``),
-the drop is started but held at its first state (``Simulation.hold``): the thread steps up to ``lead``
-of it, as it runs ahead after X, and queues the states without a due time, while the window goes on
+the drop is started but held at its first state (``Simulation.hold``): the thread steps the first
+``lead`` of it, as it runs ahead after X, and queues the states without a due time, while the window goes on
 showing the first one. X lets it go (``Simulation.start``, a command that does not rewind): the
 queued states get their due times from that instant, so the run starts with its lead already taken
 instead of building it meanwhile. pile.toml's landing costs more than the physics thread gets beside
@@ -80,6 +80,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 from typing import Any
 
 from .handover import HudFacts, Needs, Shown, capture
@@ -91,8 +92,10 @@ IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes
 BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
 # s of wall time the physics may run ahead of what the window shows while a live run plays (see
 # "Running ahead" above; 0 turns it off, for comparisons), and s of simulated time per hand-over
-# meanwhile
-LEAD_SECONDS = 0.5
+# meanwhile. A second: held before X, pile.toml's lead then reaches 0.4 s into its landing (half a
+# second held stopped at the end of its fall, and the landing still ran the queue dry: 0.89-0.93 of
+# real time shown, against 0.99-1.00)
+LEAD_SECONDS = 1.0
 LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
@@ -257,6 +260,15 @@ class PhysicsThread:
         sim = self.sim
         return sim.real_time_factor / max(sim.time_scale, 1e-9)
 
+    def live_rates(self, shown: Shown) -> HudFacts:
+        """``shown``'s HUD facts with the real-time factor and steps per second as measured now. A state
+        stepped ahead carries the readings of when it was stepped: the first second after X, stepped
+        while the scene was held, read 0 (the factor is the speed the window's states are shown at)."""
+        sim, facts = self.sim, shown.hud
+        if shown.generation != sim.generation or facts is None:
+            return facts
+        return replace(facts, real_time_factor=sim.real_time_factor, steps_per_second=sim.steps_per_second)
+
     def child_cpu(self) -> float:
         """CPU seconds used by the ghosts' process, if any (benchmarks add it to the physics')."""
         host = self.sim.ghost_host
@@ -390,7 +402,7 @@ class PhysicsThread:
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
-        state = self._capture(force_hud=False)
+        state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale  # never, while held
         if due <= done:  # behind: the window waits for this state: shown now, the rest timed from it
@@ -479,11 +491,18 @@ class PhysicsThread:
         if asked:
             self._publish(force_hud=True)
 
-    def _capture(self, force_hud: bool) -> Shown:
+    def _capture(self, force_hud: bool, ahead: bool = False) -> Shown:
+        """A Shown of the state now. The HUD's facts are read afresh every HUD_INTERVAL of the time the
+        window shows it in: wall time, or for a state ``ahead`` (queued), its simulated time."""
         now = time.perf_counter()
         needs = self.needs()
         hud = self._hud
-        if force_hud or hud is None or now >= self._hud_at or not needs.hud:
+        if ahead and hud is not None:  # due HUD_INTERVAL after the facts' state, or stepped back from it
+            since = (self.sim.world.time - hud.time) / max(self.sim.time_scale, 1e-9)
+            due = not 0.0 <= since < HUD_INTERVAL
+        else:
+            due = now >= self._hud_at
+        if force_hud or hud is None or due or not needs.hud:
             hud = HudFacts.of(self.sim)
             self._hud, self._hud_at = hud, now + HUD_INTERVAL
         self.captures += 1
