@@ -38,7 +38,13 @@ from typing import Any
 
 from .ghosts import GhostFrame, GhostRun, Ghosts, GhostSpec
 
-AHEAD = 1.0  # s of simulated time the child steps past the main run's latest step
+# s of simulated time the child steps past the main run's latest step, at most: no further than half
+# the span of the frames kept on the main side (``reach``). Far ahead, its work for the first seconds
+# is done while the scene waits for X (the drop is held: stepper.py), not beside the window as it
+# lands: slopes.toml's ghosts took 0.54-0.57 of a core while it landed 1 s ahead, 0.39-0.41 at 5 s
+# (the resting balls' steps before they sleep are done by then), and the landing was drawn at 55-58
+# FPS against 48-55 in three alternated pairs (docs/benchmarks.md)
+AHEAD = 5.0
 BATCH = 4  # steps taken between looks at the pipe (one message back for them)
 BODY_BUDGET = 400  # balls × ghosts sent with every step; beyond it, poses every 4 steps
 KEEP_FRAMES = 2048  # frames kept on the main side (about 8 s at 240 steps a second)
@@ -47,6 +53,16 @@ BODY_MEMORY = 64 << 20  # bytes of balls' poses kept at most on the main side (6
 # window's frames and the main run's real time come first and the ghosts fall behind (drawn at the
 # latest step they reached) rather than the other way round; with CPU to spare it changes nothing.
 NICE = 5
+
+
+def reach(spec: GhostSpec) -> tuple[int, int, int]:
+    """How far the ghosts of ``spec`` go: (steps the child steps past the main run's latest step,
+    steps between the frames sent with balls' poses, frames with poses kept on the main side)."""
+    ball_ghosts = len(spec.reference.spheres) * len(spec.integrators)
+    every = 1 if ball_ghosts <= BODY_BUDGET else 4
+    keep = int(min(KEEP_FRAMES, max(16, BODY_MEMORY // (64 * max(ball_ghosts, 1)))))
+    ahead = min(round(AHEAD / spec.timestep), keep * every // 2, KEEP_FRAMES // 2) if spec.live else 0
+    return ahead, every, keep
 
 
 def serve(conn: Any) -> None:
@@ -88,8 +104,7 @@ def _serve(conn: Any, state: dict[str, Any]) -> None:
                 spec: GhostSpec = message[2]
                 ghosts = Ghosts(spec)
                 target = spec.target
-                ahead = round(AHEAD / spec.timestep) if spec.live else 0
-                every = 1 if len(spec.reference.spheres) * len(spec.integrators) <= BODY_BUDGET else 4
+                ahead, every, _ = reach(spec)
             elif ghosts is not None and kind == "seek":  # the main run is at that step now
                 ghosts.seek(target := message[2])
             elif ghosts is not None and kind == "edit":
@@ -194,9 +209,8 @@ class GhostHost:
 
     def start(self, spec: GhostSpec) -> None:
         """New ghosts from ``spec`` in place of any before (a new epoch, every frame forgotten)."""
-        ball_ghosts = max(len(spec.reference.spheres) * len(spec.integrators), 1)
         with self._lock:
-            self._frames.keep = int(min(KEEP_FRAMES, max(16, BODY_MEMORY // (64 * ball_ghosts))))
+            self._frames.keep = reach(spec)[2]
             self.error = None
         self.send(("start", self.new_epoch(None), spec))
 
@@ -287,6 +301,7 @@ class RemoteGhosts(GhostRun):
         super().__init__(spec)
         self.host = host
         self.target = spec.target  # the main run's latest step, as far as the child was told
+        self.ahead = reach(spec)[0]  # steps the child steps past it
         self._told = spec.target
         self._on = True
         host.start(spec)
