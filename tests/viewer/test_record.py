@@ -67,6 +67,27 @@ def assert_same_trajectory(record, expected) -> None:
         assert np.array_equal(record[column], expected[column]), column  # bit for bit
 
 
+def test_a_record_closed_before_x_holds_only_the_start_though_the_drop_was_stepped_meanwhile(xvfb, tmp_path):
+    # waiting for X, the physics thread steps the drop's first second ahead (stepper.py, "Held before X");
+    # none of it was shown, so none of it is recorded
+    scene = tmp_path / "slopes.toml"
+    shutil.copy(default_scene_path(), scene)
+    with viewer(xvfb, tmp_path, str(scene), "--record", "run.npz") as proc:
+        time.sleep(2.0)
+        xdotool(xvfb, "key", "Escape")
+        time.sleep(0.3)
+        xdotool(xvfb, "key", "Escape")
+        out, err = finish(proc)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+    assert "recorded 0 steps (5 balls) to run.npz" in out
+    record = np.load(tmp_path / "run.npz")
+    assert np.unique(record["time"]).tolist() == [0.0]
+    simulate(scene, 1, tmp_path / "sim.npz")
+    expected = np.load(tmp_path / "sim.npz")
+    start = expected["time"] == 0.0
+    assert_same_trajectory(record, {column: expected[column][start] for column in TRAJECTORY_COLUMNS})
+
+
 @needs_xdotool
 def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_path):
     scene = tmp_path / "slopes.toml"
