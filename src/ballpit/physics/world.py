@@ -281,15 +281,18 @@ class World:
     def step(self, dt: float) -> ContactRecord:
         """Advance the world by ``dt`` seconds; returns the contacts resolved in the step.
 
-        The stages, as docs/architecture.md draws them (step/): refuse what cannot be stepped; wake
-        what was moved, collide, wake what the awake balls reach and collide again; the crowd test
-        plans the step; take it as a soft frame (retried with more substeps) or split at every impact,
-        and again from its start if it struck a sleeping ball; still islands fall asleep; undo a step
-        that made anything non-finite. ``profile`` then holds the step's time per stage.
-        """
+        The stages, as docs/architecture.md draws them (step/): refuse what cannot be stepped; all
+        asleep, only the time moves; wake what was moved, collide, wake what the awake balls reach and
+        collide again; the crowd test plans the step; take it as a soft frame (retried with more
+        substeps) or split at every impact, again if it struck a sleeping ball; still islands fall
+        asleep; undo a step that made anything non-finite. ``profile`` holds its time per stage."""
         step = pipeline.prepare(
             self.model, self.parts, self._workspace, dt, self._good_planes, self._good_balls
         )
+        if pipeline.at_rest(step):  # all asleep: nothing but the time moves
+            record = pipeline.rest(step)
+            self._after_step(step, pipeline.Strategy.SPLIT)
+            return record
         taken = pipeline.take(step)  # wake, plan, checkpoint, solve: again while a sleeper was struck
         pipeline.settle(taken.step, taken.awake)
         record = pipeline.finish(taken.step, taken.checkpoint, taken.plan, len(taken.awake.collision.pairs))

@@ -77,3 +77,61 @@ def test_settle_puts_a_still_island_to_sleep_and_its_warm_start_aside():
     settle(step, awake)
     assert world.asleep.all()
     assert len(world.parts.warm.asleep[0]) == 3  # the three contacts' warm start, put aside
+
+
+def two_balls_asleep_on_a_floor() -> ballpit.World:
+    world = ballpit.World(sleep=True)
+    world.add_plane()
+    world.add_spheres([(0, 0.1, 0), (0.5, 0.1, 0)], radius=0.1)
+    for _ in range(round(TIME_TO_SLEEP / DT) + 60):
+        world.step(DT)
+    assert world.asleep.all()
+    return world
+
+
+def parts_bytes(world: ballpit.World) -> dict:
+    """Every part a step reads or writes, pickled field by field (the time apart)."""
+    import pickle
+
+    state = world.parts.state
+    out = {name: pickle.dumps(value) for name, value in vars(state).items() if name != "time"}
+    out |= {"pairs": pickle.dumps(world.parts.pairs), "warm": pickle.dumps(world.parts.warm)}
+    return out | {"model": pickle.dumps(world.model)}
+
+
+def test_a_world_at_rest_is_stepped_as_the_full_stages_step_it_with_only_the_time_moving():
+    from ballpit.physics import step as pipeline
+
+    world = two_balls_asleep_on_a_floor()
+    full = ballpit.World()
+    full.restore(world.snapshot())
+    before = parts_bytes(world)
+    for _ in range(50):
+        assert pipeline.at_rest(prepared(world, DT))
+        assert len(world.step(DT)) == 0  # no contact resolved
+        step = prepared(full, DT)  # every stage, as a world with a ball awake is stepped
+        taken = pipeline.take(step)
+        settle(taken.step, taken.awake)
+        pipeline.finish(taken.step, taken.checkpoint, taken.plan, len(taken.awake.collision.pairs))
+    assert parts_bytes(world) == parts_bytes(full) == before
+    assert world.time == full.time  # the same sum of the same steps
+    assert world.profile.pairs == 0
+
+
+def test_a_world_at_rest_wakes_when_a_ball_is_set_moving_or_added_or_a_plane_moves():
+    from ballpit.physics import step as pipeline
+
+    world = two_balls_asleep_on_a_floor()
+    world.spheres[1].velocity = (1.0, 0.0, 0.0)
+    assert not pipeline.at_rest(prepared(world, DT))
+    x = world.spheres[1].position[0]
+    world.step(DT)
+    assert world.spheres[1].position[0] > x and not world.asleep[1]  # the by-hand push moves it
+    world = two_balls_asleep_on_a_floor()
+    world.add_sphere(position=(0, 1.0, 0), radius=0.1)
+    assert not pipeline.at_rest(prepared(world, DT))  # the new ball is awake: it falls
+    world.step(DT)
+    assert world.spheres[2].velocity[1] < 0.0
+    world = two_balls_asleep_on_a_floor()
+    world.planes[0].velocity = (0.0, 0.1, 0.0)
+    assert not pipeline.at_rest(prepared(world, DT))

@@ -1,9 +1,10 @@
 """A step as a pipeline of typed stages (docs/architecture.md draws it; ``World.step`` reads as it):
 
-    prepare -> wake -> plan -> solve (soft frames, retried; else split at impacts) -> struck -> settle
-        -> finish
+    prepare -> (at rest: rest) -> wake -> plan -> solve (soft frames, retried; else split at impacts)
+        -> struck -> settle -> finish
 
 - ``prepare``: refuse what cannot be stepped; the step's settings and outputs (``Step``).
+- ``at_rest`` (sleep.py): every ball asleep and nothing moved them; then ``rest`` only advances the time.
 - ``wake`` (sleep.py): wake what was moved by hand, collide (collide.py: the kept pairs and the
   narrow phase), wake the islands the awake balls reach and collide again.
 - ``plan`` (plan.py): the crowd test, split at impacts or a soft frame of n substeps.
@@ -35,7 +36,7 @@ from .checkpoint import Checkpoint, Parts
 from .collide import measure
 from .context import Step
 from .plan import Plan, Strategy, plan
-from .sleep import Awake, settle, struck, wake
+from .sleep import Awake, at_rest, settle, struck, wake
 
 __all__ = [
     "Awake",
@@ -43,9 +44,11 @@ __all__ = [
     "Step",
     "Strategy",
     "Taken",
+    "at_rest",
     "finish",
     "plan",
     "prepare",
+    "rest",
     "settle",
     "solve",
     "struck",
@@ -116,6 +119,16 @@ def take(step: Step) -> Taken:
         checkpoint.restore(step.parts)
         step.state.sleep.wake(hit)
         step = step.again()
+
+
+def rest(step: Step) -> ContactRecord:
+    """The step of a world at rest (``at_rest``): only the time advances; no contact is resolved."""
+    step.state.time += step.dt
+    record = step.events.record()
+    prof = step.profile
+    prof.intervals, prof.pairs, prof.contacts, prof.crowded = 0, 0, 0, False
+    prof.total = perf_counter() - step.began
+    return record
 
 
 def finish(step: Step, checkpoint: Checkpoint, chosen: Plan, pairs: int) -> ContactRecord:
