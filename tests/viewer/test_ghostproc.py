@@ -235,3 +235,34 @@ def test_after_a_move_back_in_time_the_child_steps_ahead_of_that_step_not_of_the
         assert apart.ghost_host.reached == ahead  # ...and stops there, not 0.5 s later
     finally:
         close(apart)
+
+
+@pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
+def test_the_child_hears_how_far_the_run_got_once_an_eighth_of_its_reach_and_stays_that_far_ahead():
+    _, apart = pair()
+    try:
+        both((apart,), lambda sim: (sim.toggle_ghosts(), sim.start()))
+        ghosts, host = apart.timeline.ghosts, apart.ghost_host
+        tell = ghosts.ahead // 8
+
+        def reached_after(steps: int) -> int:
+            """Step the run ``steps`` steps, sampling the energy every one (as the viewer's thread does
+            every frame); the step the child then stops at."""
+            for _ in range(steps):
+                apart.lead(1)
+            time.sleep(0.5)
+            ghosts.frame_at(ghosts.target, wait=WAIT)  # it is past the run's step
+            deadline = time.perf_counter() + WAIT
+            while time.perf_counter() < deadline:
+                before = host.reached
+                time.sleep(0.3)
+                if host.reached == before:
+                    return before
+            raise AssertionError("the child never stopped")
+
+        first = reached_after(0)
+        assert first == ghosts.ahead  # the run at step 0: its reach past it
+        assert reached_after(tell - 1) == first  # not told yet: it waits where it was
+        assert reached_after(1) == tell + ghosts.ahead  # told: its whole reach past the run again
+    finally:
+        close(apart)

@@ -310,9 +310,12 @@ class RemoteGhosts(GhostRun):
         """The main run took a live step (the child is told at the next ``flush``)."""
         self.target += 1
 
-    def flush(self) -> None:
-        """Tell the child how far the main run has got."""
-        if self.target != self._told:
+    def flush(self, soon: bool = False) -> None:
+        """Tell the child how far the main run has got. ``soon`` (every frame's energy sample): only once
+        it has got an eighth of the child's reach on since last told. The child is then always more
+        than 7/8 of its reach ahead, and the physics thread sends 60 times fewer messages (each a
+        write that lets go of the GIL and waits to have it back: 4 % of the thread's time)."""
+        if self.target != self._told and (not soon or self.target - self._told >= max(self.ahead // 8, 1)):
             self._told = self.target
             self.host.send(("to", self.target))
 

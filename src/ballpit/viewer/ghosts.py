@@ -126,8 +126,9 @@ class GhostRun:
         """Frames received since the last call (their energies fill the energy trace)."""
         return []
 
-    def flush(self) -> None:
-        """Say how far the main run has got (nothing to do when they are stepped here)."""
+    def flush(self, soon: bool = False) -> None:
+        """Say how far the main run has got (nothing to do when they are stepped here). ``soon``: only
+        once it has got far enough on since last said."""
 
     def close(self) -> None:
         """Stop stepping them (nothing to do when they are stepped here)."""

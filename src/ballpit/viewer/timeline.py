@@ -220,7 +220,7 @@ class Timeline:
         totals = {world.integrator: kinetic + potential}
         ghosts = self.ghosts
         if ghosts is not None:
-            ghosts.flush()
+            ghosts.flush(soon=True)
             totals |= ghosts.totals_at(self._step) or {}
         self.energy.add(world.time, kinetic, potential, totals)
         self.take_ghost_news()
