@@ -333,23 +333,3 @@ def crosses_slope_at(point, height: float, half: float) -> bool:
     point = np.asarray(point, float)
     hit = point + SUN * (height - point[1]) / SUN[1]
     return bool(abs(hit[0]) < half and abs(hit[2]) < half)
-
-
-def test_a_state_handed_over_with_its_balls_binned_draws_the_shadows_the_window_would_bin(offscreen):
-    # the physics side bins the balls with the state it hands over (Needs.shadow_limit), so the
-    # window's thread only uploads the grid: the same grid, the same pixels
-    from ballpit.viewer.handover import Needs, capture
-
-    sim = floor_scene([((0.0, 0.4, 0.0), 0.4), ((0.6, 1.2, 0.3), 0.3), ((-0.5, 0.25, 0.4), 0.25)])
-    binned_here = offscreen.render(sim, CAMERA)
-    grid_here = offscreen.renderer.shadow_grid
-    shown = capture(sim, Needs(shadow_limit=offscreen.renderer.shadow_limit))
-    assert shown.shadows is not None
-    offscreen.window.switch_to()
-    offscreen.feeder.upload(shown, None, CAMERA.position)
-    handed = offscreen.draw(CAMERA)
-    assert offscreen.renderer.shadow_grid is shown.shadows  # uploaded as binned, not binned again
-    for name in ("ranges", "balls", "origin", "axes"):
-        np.testing.assert_array_equal(getattr(shown.shadows, name), getattr(grid_here, name))
-    np.testing.assert_array_equal(handed, binned_here)
-    assert len(shown.shadows.balls) >= 3  # every ball is in a cell

@@ -183,9 +183,8 @@ class Viewer:
 
     def _needs(self) -> Needs:
         """What the physics should copy for the window (asked at every hand-over)."""
-        f, renderer = self.flags, self.renderer
-        limit = renderer.shadow_limit if renderer.shadows else 0
-        return Needs(f.contacts, f.velocities, f.trails, shadow_limit=limit)
+        f = self.flags
+        return Needs(f.contacts, f.velocities, f.trails)
 
     def _watch(self, sim: Simulation) -> object:
         """The panel's copy of the run (physics side, at each hand-over): settings, the selection,

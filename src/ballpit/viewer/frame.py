@@ -61,9 +61,7 @@ class FrameFeeder:
             self._generation, self._plane_pose = shown.generation, pose
             self.plane_uploads += 1
         positions = shown.positions
-        renderer = self.renderer
-        grid = shown.shadows if shown.shadow_limit == renderer.shadow_limit else None  # binned already
-        renderer.upload_balls(positions, shown.orientations, shown.radii, shown.sphere_colors, eye, grid)
+        self.renderer.upload_balls(positions, shown.orientations, shown.radii, shown.sphere_colors, eye)
         self._upload_ghosts(shown)
 
         trails, overlay_lines = overlays.empty(), overlays.empty()

@@ -30,9 +30,6 @@ class Needs:
     trails: bool = False
     energy: bool = False
     hud: bool = True
-    # balls kept per cell of the shadow grid (shadows.py), binned here with the state rather than on the
-    # window's thread, where it cost 0.5 ms of each frame; 0: the window bins them
-    shadow_limit: int = 0
 
 
 @dataclass
@@ -121,8 +118,6 @@ class Shown:
     time: float = 0.0  # the World's time (s) of the state copied
     step: int | None = None  # its step in the history (None before the drop, or in a replay)
     watch: Any = None  # the panel's copy of the run (watch.py), when the window has a panel
-    shadows: Any = None  # the balls' shadow grid (shadows.ShadowGrid), binned with ``shadow_limit``
-    shadow_limit: int = 0
 
     @property
     def ball_count(self) -> int:
@@ -163,11 +158,6 @@ def capture(sim: Simulation, needs: Needs = Needs(), hud: HudFacts | None = None
         time=float(world.time),
         step=sim.timeline.history.current if sim.timeline.history is not None else None,
     )
-    if needs.shadow_limit and len(positions):
-        from . import shadows
-
-        shown.shadows = shadows.build(shown.positions, shown.radii, shadows.SUN, limit=needs.shadow_limit)
-        shown.shadow_limit = needs.shadow_limit
     if needs.velocities:
         shown.velocities = np.array(spheres.velocities, dtype=float)
     if needs.contacts and sim.contacts is not None and len(sim.contacts):

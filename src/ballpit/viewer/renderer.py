@@ -179,7 +179,7 @@ class Renderer:
 
         # ball shadows: the grid of balls seen from the sun, two texture buffers the plane shader reads
         self.shadows = True  # False: planes are drawn without ball shadows or contact darkening
-        self.sun_direction = shadows.SUN.copy()
+        self.sun_direction = np.asarray(shadows.SUN_DIRECTION, dtype=np.float32)
         self.shadow_limit = shadows.LIMIT  # balls kept per grid cell
         self.shadow_grid = shadows.empty_grid(self.sun_direction)
         self.shadow_seconds = 0.0
@@ -274,16 +274,15 @@ class Renderer:
         radii: np.ndarray,
         colors: np.ndarray,
         eye: np.ndarray | None = None,
-        grid: shadows.ShadowGrid | None = None,
     ) -> None:
         """Fill the per-instance buffer from whole arrays: one ``glBufferData`` for all balls.
 
         Given the ``eye``, many balls are ordered nearest first, so the depth test rejects the hidden
         ones before they are shaded (it halves the draw of a 10,000-ball pile on a CPU rasteriser).
-        The shadow grid is ``grid`` (binned from the same positions elsewhere), or binned here.
+        The shadow grid is rebuilt from the same positions.
         """
         started = time.perf_counter()
-        self.upload_shadows(positions, radii, grid)
+        self.upload_shadows(positions, radii)
         n = len(positions)
         if self._instances.shape[0] != n:
             self._instances = np.zeros((n, BALL_STRIDE), dtype=np.float32)
@@ -304,16 +303,13 @@ class Renderer:
         self.ball_count = n
         self.upload_seconds = time.perf_counter() - started
 
-    def upload_shadows(
-        self, positions: np.ndarray, radii: np.ndarray, grid: shadows.ShadowGrid | None = None
-    ) -> None:
-        """Bin the balls in the sun's grid (unless ``grid`` holds them binned already) and upload it
-        (two buffer uploads, whatever the count)."""
+    def upload_shadows(self, positions: np.ndarray, radii: np.ndarray) -> None:
+        """Bin the balls in the sun's grid and upload it (two buffer uploads, whatever the count)."""
         started = time.perf_counter()
-        if not (self.shadows and len(positions)):
-            grid = shadows.empty_grid(self.sun_direction)
-        elif grid is None:
+        if self.shadows and len(positions):
             grid = shadows.build(positions, radii, self.sun_direction, limit=self.shadow_limit)
+        else:
+            grid = shadows.empty_grid(self.sun_direction)
         for buffer, data in zip(self.shadow_buffers, (grid.balls, grid.ranges), strict=True):
             GL.glBindBuffer(GL.GL_TEXTURE_BUFFER, buffer)
             GL.glBufferData(GL.GL_TEXTURE_BUFFER, max(data.nbytes, 16), data if data.nbytes else None,

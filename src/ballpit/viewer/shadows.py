@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 
 SUN_DIRECTION = np.array([0.35, 0.85, 0.40]) / np.linalg.norm([0.35, 0.85, 0.40])  # towards the sun
-SUN = SUN_DIRECTION.astype(np.float32)  # as the renderer holds it (the grid binned with the state uses it)
 REACH = 2.5  # ball radii, across the sun direction, beyond which a ball neither shadows nor darkens
 LIMIT = 12  # balls kept per cell: the most a fragment reads
 MAX_CELLS = 65_535  # cells in the grid at most (about 256 x 256; a cell number fits 16 bits)
