@@ -238,12 +238,15 @@ def test_after_a_move_back_in_time_the_child_steps_ahead_of_that_step_not_of_the
 
 
 @pytest.mark.slow  # seconds of subprocesses or real-time steps: make test, not make check
-def test_the_child_hears_how_far_the_run_got_once_an_eighth_of_its_reach_and_stays_that_far_ahead():
+def test_the_child_hears_how_far_the_run_got_every_bit_of_its_reach_and_stays_that_far_ahead():
+    from ballpit.viewer.ghostproc import TELL_EVERY
+
     _, apart = pair()
     try:
         both((apart,), lambda sim: (sim.toggle_ghosts(), sim.start()))
         ghosts, host = apart.timeline.ghosts, apart.ghost_host
-        tell = ghosts.ahead // 8
+        tell = round(ghosts.ahead * TELL_EVERY)
+        assert tell > 1
 
         def reached_after(steps: int) -> int:
             """Step the run ``steps`` steps, sampling the energy every one (as the viewer's thread does
