@@ -237,7 +237,7 @@ class Simulation:
             self.timeline.started()
 
     def hold(self) -> bool:
-        """Start the drop, but held at its first state until X: the physics thread steps its first second
+        """Start the drop, but held at its first state until X: the physics thread steps its first lead
         ahead while the scene waits (stepper.py, "Held before X"), and X lets it go on from there. The
         phase stays WAITING, so everything else asked before X sees the run waiting; it undoes the hold
         first (``unhold``). False when there is nothing to hold (not waiting, or a replay)."""

@@ -92,17 +92,18 @@ IDLE_WAIT = 0.05  # seconds the thread sleeps when nothing runs (a command wakes
 BUSY_WINDOW = 0.5  # seconds of wall time over which the thread's busy share is measured
 # s of wall time the physics may run ahead of what the window shows while a live run plays (see
 # "Running ahead" above; 0 turns it off, for comparisons), and s of simulated time per hand-over
-# meanwhile. A second: held before X, pile.toml's lead then reaches 0.4 s into its landing (half a
-# second held stopped at the end of its fall, and the landing still ran the queue dry: 0.89-0.93 of
-# real time shown, against 0.99-1.00)
-LEAD_SECONDS = 1.0
+# meanwhile. 1.5 s: held before X, pile.toml's lead then reaches 0.9 s into its landing. Half a
+# second held stopped at the end of its fall, and the landing still ran the queue dry (0.89-0.93 of
+# real time shown); a second fell short in the host's slow spells (0.92 and 0.96 in 24 runs); 1.5 s
+# kept it at 0.995-0.999 in four runs alternated with 1 s (docs/benchmarks.md)
+LEAD_SECONDS = 1.5
 LEAD_FRAME = 1.0 / 60.0
 # s: Python's GIL switch interval while the thread runs (5 ms by default): how long the window may
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = 0.001
 GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach the main run's step
 HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
-HOLD_SECONDS = 2.0  # s of wall time a hold steps at most
+HOLD_SECONDS = 3.0  # s of wall time a hold steps at most (pile.toml: 1.2-1.4 s for its 1.5 s)
 HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
 
 
@@ -138,7 +139,7 @@ class PhysicsThread:
         hold: bool = True,
     ) -> None:
         self.sim = sim
-        self.hold = hold  # a waiting scene is held, its first second stepped before X
+        self.hold = hold  # a waiting scene is held, its first lead stepped before X
         if ghosts_apart:  # the integrator ghosts' worlds in a process of their own (ghostproc.py)
             sim.ghosts_apart()
         self.lead = lead  # s of wall time the run may be stepped ahead of what the window shows
@@ -262,7 +263,7 @@ class PhysicsThread:
 
     def live_rates(self, shown: Shown) -> HudFacts:
         """``shown``'s HUD facts with the real-time factor and steps per second as measured now. A state
-        stepped ahead carries the readings of when it was stepped: the first second after X, stepped
+        stepped ahead carries the readings of when it was stepped: the first 1.5 s after X, stepped
         while the scene was held, read 0 (the factor is the speed the window's states are shown at)."""
         sim, facts = self.sim, shown.hud
         if shown.generation != sim.generation or facts is None:
