@@ -365,3 +365,19 @@ def test_a_dear_start_is_shown_in_real_time_from_the_steps_taken_while_the_scene
             physics.stop()
     assert speeds[True] == pytest.approx(1.0, abs=0.04), speeds
     assert speeds[False] < 0.8, speeds
+
+
+def test_a_waiting_scene_is_held_though_the_file_watch_asks_every_tenth_of_a_second():
+    # the file watch reads nothing the steps change (it does not rewind): it is not something asked
+    # that would undo the hold
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim)
+    try:
+        physics.run_free()
+        deadline = time.monotonic() + 10
+        while not _held(physics) and time.monotonic() < deadline:
+            physics.submit(lambda s: s.file_changed(), rewind=False)
+            time.sleep(0.1)
+        assert _held(physics)
+    finally:
+        physics.stop()

@@ -196,7 +196,8 @@ class PhysicsThread:
         With ``rewind`` (the default) the command acts on the state the window shows: steps taken
         ahead of it are dropped first. Only what reads nothing the steps change may pass False."""
         self._commands.append((command, then, rewind))
-        self._asked_at = time.perf_counter()
+        if rewind:  # the file watch's twice a second does not keep a waiting scene from being held
+            self._asked_at = time.perf_counter()
         self._wake.set()
 
     def show_again(self) -> None:
