@@ -45,6 +45,7 @@ from .ghosts import GhostFrame, GhostRun, Ghosts, GhostSpec
 # (the resting balls' steps before they sleep are done by then), and the landing was drawn at 55-58
 # FPS against 48-55 in three alternated pairs (docs/benchmarks.md)
 AHEAD = 5.0
+REAP_WAIT = 5.0  # s a closed child has to end before it is killed
 TELL_EVERY = 1 / 32  # of the child's reach: how far the main run gets on between two "to" messages
 BATCH = 4  # steps taken between looks at the pipe (one message back for them)
 BODY_BUDGET = 400  # balls × ghosts sent with every step; beyond it, poses every 4 steps
@@ -284,13 +285,22 @@ class GhostHost:
             return out
 
     def close(self) -> None:
-        """Stop the child at once (never waits for it)."""
+        """Stop the child at once (never waits for it): a daemon thread reaps it once it has ended, so it
+        leaves no zombie behind for the viewer's life (killed if it has not ended in REAP_WAIT s)."""
         self.send(("stop",))
         self.dead = True
         try:
             self._process.terminate()
         except OSError:
             pass
+        threading.Thread(target=self._reap, name="ballpit ghosts reaper", daemon=True).start()
+
+    def _reap(self) -> None:
+        try:
+            self._process.wait(timeout=REAP_WAIT)
+        except subprocess.TimeoutExpired:
+            self._process.kill()
+            self._process.wait()
 
 
 class RemoteGhosts(GhostRun):
