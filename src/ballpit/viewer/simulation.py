@@ -223,18 +223,14 @@ class Simulation:
         return Phase.RUNNING if self.held else self.phase
 
     def start(self) -> None:
-        """X: start the drop (only from the waiting state), or let a held one go on from its first state."""
-        if self.held:
-            self.held, self.phase = False, Phase.RUNNING
-            self._restart_stats()
-            self.message = "dropped"
+        """X: start the drop (only from the waiting state); a held one goes on from the steps it took."""
+        if self.phase is not Phase.WAITING:
             return
-        if self.phase is Phase.WAITING:
-            self.phase = Phase.RUNNING
-            self.accumulator = 0.0
-            self._restart_stats()
-            self.message = "dropped"
+        if not self.held:
             self.timeline.started()
+        self.held, self.phase, self.accumulator = False, Phase.RUNNING, 0.0
+        self._restart_stats()
+        self.message = "dropped"
 
     def hold(self) -> bool:
         """Start the drop, but held at its first state until X: the physics thread steps its first lead

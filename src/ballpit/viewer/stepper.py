@@ -396,11 +396,9 @@ class PhysicsThread:
         # the simulated time shown now
         shown = sim0 if held else min(sim0 + (now - wall0) * scale, sim.world.time)
         ahead = (sim.world.time - shown) / scale
-        if held and self._held_seconds >= HOLD_SECONDS:
-            return IDLE_WAIT
+        if held and (ahead >= self.lead or self._held_seconds >= HOLD_SECONDS):
+            return IDLE_WAIT  # held as far as it goes: nothing is due until X
         if ahead >= self.lead:
-            if held:
-                return IDLE_WAIT
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
@@ -450,8 +448,9 @@ class PhysicsThread:
                 self._shown.step = 0  # it is: nothing changed the world since it was captured
 
     def _released(self) -> None:
-        """X let the held run go (or a reset or reload dropped it): the states stepped meanwhile are due
-        from now, each at its simulated time from the first."""
+        """X let the held run go (or a failed step ended the hold; anything else asked undoes it first,
+        ``_rewind_to_shown``): the states stepped meanwhile are due from now, each at its simulated time
+        from the first."""
         self._holding = False
         sim = self.sim
         if self._base is None or sim.phase is not Phase.RUNNING:
@@ -461,8 +460,7 @@ class PhysicsThread:
         scale = max(sim.time_scale, 1e-9)
         self._base = self._counted = (now, sim0)
         with self._handover_lock:
-            timed = [(now + (state.time - sim0) / scale, state) for _, state in self._ahead]
-            self._ahead = deque(state for state in timed if state[1].generation == sim.generation)
+            self._ahead = deque((now + (state.time - sim0) / scale, state) for _, state in self._ahead)
 
     def _count_shown(self, now: float, shown: float) -> None:
         """The window's state had reached simulated time ``shown`` at wall time ``now``: the speed it is
