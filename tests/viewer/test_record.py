@@ -53,6 +53,14 @@ def finish(proc: subprocess.Popen) -> tuple[str, str]:
         pytest.fail(f"the viewer did not exit; {ended(proc)}")
 
 
+def quit_viewer(display: str, proc: subprocess.Popen) -> tuple[str, str]:
+    """Esc, Esc: the viewer quits (writing its record); what it printed."""
+    xdotool(display, "key", "Escape")
+    time.sleep(0.3)
+    xdotool(display, "key", "Escape")
+    return finish(proc)
+
+
 def simulate(scene: Path, steps: int, out: Path) -> None:
     """``ballpit simulate`` for exactly ``steps`` steps of the scene's timestep (its command line run in
     this process: the viewer's record is what runs apart)."""
@@ -67,17 +75,15 @@ def assert_same_trajectory(record, expected) -> None:
         assert np.array_equal(record[column], expected[column]), column  # bit for bit
 
 
+@needs_xdotool
 def test_a_record_closed_before_x_holds_only_the_start_though_the_drop_was_stepped_meanwhile(xvfb, tmp_path):
-    # waiting for X, the physics thread steps the drop's first second ahead (stepper.py, "Held before X");
+    # waiting for X, the physics thread steps the drop's first 1.5 s ahead (stepper.py, "Held before X");
     # none of it was shown, so none of it is recorded
     scene = tmp_path / "slopes.toml"
     shutil.copy(default_scene_path(), scene)
     with viewer(xvfb, tmp_path, str(scene), "--record", "run.npz") as proc:
         time.sleep(2.0)
-        xdotool(xvfb, "key", "Escape")
-        time.sleep(0.3)
-        xdotool(xvfb, "key", "Escape")
-        out, err = finish(proc)
+        out, err = quit_viewer(xvfb, proc)
     assert proc.returncode == 0 and "Traceback" not in err, err
     assert "recorded 0 steps (5 balls) to run.npz" in out
     record = np.load(tmp_path / "run.npz")
@@ -95,10 +101,7 @@ def test_a_recorded_untouched_run_equals_ballpit_simulate_bit_for_bit(xvfb, tmp_
     with viewer(xvfb, tmp_path, str(scene), "--record", "run.npz") as proc:
         xdotool(xvfb, "key", "x")
         time.sleep(2.0)  # the drop, the first bounces and spins
-        xdotool(xvfb, "key", "Escape")
-        time.sleep(0.3)
-        xdotool(xvfb, "key", "Escape")
-        out, err = finish(proc)
+        out, err = quit_viewer(xvfb, proc)
     assert proc.returncode == 0 and "Traceback" not in err, err
     record = np.load(tmp_path / "run.npz")
     assert set(record.files) == set(TRAJECTORY_COLUMNS)
@@ -128,10 +131,7 @@ def test_a_record_rewound_and_resumed_holds_the_timeline_as_it_stands_and_equals
         time.sleep(0.3)
         xdotool(xvfb, "key", "space")  # resume from the past: the later history is dropped
         time.sleep(1.0)
-        xdotool(xvfb, "key", "Escape")
-        time.sleep(0.3)
-        xdotool(xvfb, "key", "Escape")
-        _out, err = finish(proc)
+        _out, err = quit_viewer(xvfb, proc)
     assert proc.returncode == 0 and "Traceback" not in err, err
     record = np.load(tmp_path / "run.npz")
     times = record["time"].reshape(-1, 5)[:, 0]  # five balls a record
