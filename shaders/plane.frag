@@ -26,6 +26,11 @@ flat in vec3 v_color;
 flat in float v_selected;
 flat in float v_solid;
 flat in int v_index;
+#if CASTER_GROUPS > 0
+in vec4 v_caster_u[CASTER_GROUPS];      // where this point's ray meets the first casters (plane.vert)
+in vec4 v_caster_v[CASTER_GROUPS];
+in vec4 v_caster_t[CASTER_GROUPS];
+#endif
 
 uniform samplerBuffer u_shadow_balls;   // centre xyz, radius; grouped by cell, nearest the sun first
 uniform isamplerBuffer u_shadow_cells;  // cell k's balls are rows [cells[k].x, cells[k].y)
@@ -86,6 +91,31 @@ vec2 ball_shading(vec3 p, vec3 n, vec2 g) {
     return vec2(sun, ambient);
 }
 
+// The share of the sun this point sees past the casting planes: the first ones (up to eight) from the
+// rays interpolated from the vertices, any after them worked out here (casters.glsl).
+vec4 group_shades(vec4 along_u, vec4 along_v, vec4 t, int g) {
+    vec4 half_u = vec4(u_caster_half[4 * g].x, u_caster_half[4 * g + 1].x, u_caster_half[4 * g + 2].x,
+                       u_caster_half[4 * g + 3].x);
+    vec4 half_v = vec4(u_caster_half[4 * g].y, u_caster_half[4 * g + 1].y, u_caster_half[4 * g + 2].y,
+                       u_caster_half[4 * g + 3].y);
+    return caster_shades(along_u, along_v, t, half_u, half_v);
+}
+
+float planes_shadow() {
+    vec4 sun = vec4(1.0);
+#if CASTER_GROUPS > 0
+    sun = min(sun, group_shades(v_caster_u[0], v_caster_v[0], v_caster_t[0], 0));
+#endif
+#if CASTER_GROUPS > 1
+    sun = min(sun, group_shades(v_caster_u[1], v_caster_v[1], v_caster_t[1], 1));
+#endif
+    float rest = 1.0;
+#if CASTERS > 4 * CASTER_GROUPS
+    rest = plane_shadow_from(v_world, v_index, 4 * CASTER_GROUPS);
+#endif
+    return min(min(min(sun.x, sun.y), min(sun.z, sun.w)), rest);
+}
+
 void main() {
     bool back = !gl_FrontFacing;
     if (back && (v_solid > 0.5) != (u_back_pass > 0.5)) discard;  // drawn in the other back pass
@@ -113,7 +143,7 @@ void main() {
     }
 
     vec2 shading = see_through ? vec2(1.0) : ball_shading(v_world, n, v_shadow_grid);
-    if (!see_through && dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, plane_shadow(v_world, v_index));
+    if (!see_through && dot(n, u_sun_direction) > 0.0) shading.x = min(shading.x, planes_shadow());
     vec3 color = shade_lit(albedo, n, v_world, 24.0, 0.08, shading.x, shading.y);
     frag_color = vec4(fog(color, v_world), alpha);
 }

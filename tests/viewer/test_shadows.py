@@ -262,6 +262,38 @@ def test_each_of_several_slopes_shades_the_floor(offscreen):
         assert empty[row, col] - image[row, col] > 100
 
 
+def test_the_casters_shade_met_at_the_vertices_is_the_shade_worked_out_at_each_pixel(offscreen):
+    """The plane program meets the first eight casters' rays per vertex and interpolates them
+    (casters.glsl, CASTER_GROUPS); ten slopes here, so two groups and two casters per pixel. The picture
+    is the one a program working out every caster at every pixel draws."""
+    world = ballpit.World(gravity=(0, 0, 0))
+    world.add_plane(position=(0, 0, 0))
+    for i in range(10):
+        x, z = -3.0 + 1.4 * (i % 5), -2.4 + 2.2 * (i // 5)
+        world.add_plane(position=(x, 1.0 + 0.15 * i, z), rotation=(8.0 * (i % 3), 0, 12 - 5 * i), size=0.9)
+    sim = Simulation(world)
+    renderer = offscreen.renderer
+    drawn = offscreen.render(sim, CAMERA)
+    casters = len(renderer._caster_index)
+    assert casters == 10
+    per_pixel = renderer_module.Program(
+        "plane.vert", "plane.frag", None, {"CASTERS": casters, "CASTER_GROUPS": 0}
+    )
+    interpolated = renderer.plane_program
+    try:
+        per_pixel.use()
+        per_pixel.set_int("u_shadow_balls", renderer_module.SHADOW_BALLS_UNIT)
+        per_pixel.set_int("u_shadow_cells", renderer_module.SHADOW_CELLS_UNIT)
+        renderer.plane_program = per_pixel
+        worked_out = offscreen.draw(CAMERA)
+    finally:
+        renderer.plane_program = interpolated
+        per_pixel.delete()
+    floor_only = brightness(offscreen.render(floor_scene([]), CAMERA))
+    assert ((floor_only - brightness(drawn)) > 150).mean() > 0.05  # the slopes' shade is in it
+    assert np.abs(drawn.astype(int) - worked_out.astype(int)).max() <= 2
+
+
 # ---------------------------------------------------------------- the grid itself (no GL)
 
 
