@@ -126,10 +126,14 @@ def tick(_dt):
         state["ghosts"] = False
         viewer.window.dispatch_event("on_key_press", key.G, 0)
     if phase == "warm" and now >= state["at"]:
-        state.update(phase="before", at=now + seconds, mark=mark())
+        state.update(phase="before", at=now + seconds, mark=mark(), cpu=thread_cpu())
     elif phase == "before" and now >= state["at"]:
         frames, _, t = state["mark"]
         out["fps_before_x"] = (viewer.frames - frames) / (now - t)
+        cpu = thread_cpu()
+        for kind in ("main", "llvmpipe"):  # CPU ms a frame: the view is drawn once and shown again
+            used = cpu[kind] - state["cpu"][kind]
+            out[f"{kind}_ms_frame_before"] = used * 1e3 / max(viewer.frames - frames, 1)
         out["panel_ms_before"] = viewer.panel.cost_ms() if panel else None
         out["panel_cpu_ms_before"] = viewer.panel.cost_ms(cpu=True) if panel else None
         viewer.panel.seconds.clear()
@@ -172,6 +176,9 @@ def tick(_dt):
             cpu = thread_cpu()
             for kind, used in cpu.items():
                 out[f"cpu_{kind}"] = (used - state["cpu"][kind]) / wall
+            for kind in ("main", "llvmpipe"):  # CPU ms a frame, the view drawn at every frame
+                used = cpu[kind] - state["cpu"][kind]
+                out[f"{kind}_ms_frame_land"] = used * 1e3 / max(viewer.frames - frames, 1)
             physics = out["cpu_physics"] + out["cpu_ghosts"]
             out["physics_cpu_per_sim_s"] = physics * wall / max(simulated, 1e-9)
             out["physics_asleep"] = 1.0 - out["cpu_physics"] - out["cpu_physics_queued"]
@@ -227,6 +234,8 @@ COLUMNS = ["fps_before_x", "land_fps", "land_rtf", "hud_rtf", "hud_rtf_min", "fp
 COLUMNS += ["panel_cpu_ms_before", "panel_cpu_ms_land"]
 VIDEO_COLUMNS = ["video_frames", "video_seconds", "read_ms", "encode_wait"]
 THREAD_COLUMNS = ["cpu_physics", "cpu_ghosts", "cpu_main", "cpu_llvmpipe", "cpu_other",
+                  "main_ms_frame_before", "llvmpipe_ms_frame_before", "main_ms_frame_land",
+                  "llvmpipe_ms_frame_land",
                   "physics_cpu_per_sim_s", "cpu_physics_queued", "physics_asleep", "physics_idle",
                   "physics_capture"]  # fmt: skip
 

@@ -1,6 +1,6 @@
 #version 330 core
-// Bilinear sample of the smaller image (the texture's own filter): cheaper on a CPU rasteriser than
-// glBlitFramebuffer, which takes a generic path there.
+// The smaller image's texel under this pixel (the texture's own filter, nearest): cheaper on a CPU
+// rasteriser than glBlitFramebuffer, which takes a generic path there, and than bilinear filtering.
 
 in vec2 v_uv;
 uniform sampler2D u_image;
