@@ -249,15 +249,58 @@ def test_a_record_closed_while_the_run_is_ahead_ends_at_the_state_the_window_sho
         assert run["time"].max() == shown.time
 
 
+def _steps_while_drawing(physics: PhysicsThread, drawing: bool) -> float:
+    """The share of windows of 5 ms, each opened 2 ms after a frame began (a batch under way ends
+    first), in which the thread stepped; windows the test's own thread overslept (beyond 8 ms, under
+    load) are left out."""
+    stepped, windows = 0, 0
+    for _ in range(60):
+        physics.window_drawing(drawing)
+        time.sleep(0.002)
+        before, began = physics.sim.world.time, time.perf_counter()
+        time.sleep(0.005)
+        after, ended = physics.sim.world.time, time.perf_counter()
+        physics.window_drawing(False)
+        if ended - began < 0.008:
+            windows += 1
+            stepped += after != before
+        if windows == 12:
+            break
+        time.sleep(0.02)  # the window waits for the rasteriser: the thread catches up
+    assert windows >= 6
+    return stepped / windows
+
+
+def test_a_run_far_ahead_waits_for_the_window_to_lay_out_its_frame_and_steps_in_between():
+    # At 4 times real time and a 1/60 s step the thread needs a batch every 4 ms, so it steps in nearly
+    # every 5 ms window; far enough ahead, not while the window lays out a frame (GATE_WAIT: 10 ms).
+    world = line_of_balls(1)
+    sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))
+    physics = PhysicsThread(sim, lead=2.0)
+    try:
+        physics.submit(lambda s: (s.start(), setattr(s, "time_scale", 4.0)))
+        physics.run_free()
+        far = 2 * stepper.GATE_AHEAD * 4.0
+        assert wait_for(lambda: sim.world.time - physics.shown.time > far, timeout=30.0)
+        free = _steps_while_drawing(physics, drawing=False)
+        laid_out = _steps_while_drawing(physics, drawing=True)
+        assert sim.world.time - physics.shown.time > stepper.GATE_AHEAD * 4.0  # still far ahead
+    finally:
+        physics.stop()
+    assert free >= 0.6, free
+    assert laid_out <= 0.3, laid_out
+
+
 def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_thread():
     """The lead, the switch interval and where the ghosts run."""
     defaults = {"lead": stepper.LEAD_SECONDS, "switch_interval": stepper.SWITCH_INTERVAL}
-    defaults |= {"ghosts_apart": True, "hold": True}
+    defaults |= {"ghosts_apart": True, "hold": True, "gate_ahead": stepper.GATE_AHEAD}
     assert stepper.tuning_from({}) == defaults
     environ = {"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002", "BALLPIT_GHOSTS": "thread"}
-    environ["BALLPIT_HOLD"] = "0"
+    environ |= {"BALLPIT_HOLD": "0", "BALLPIT_GATE": "inf"}
     tuned = stepper.tuning_from(environ)
-    assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False, "hold": False}
+    assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False, "hold": False,
+                     "gate_ahead": math.inf}  # fmt: skip
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, **tuned)
     try:

@@ -343,6 +343,14 @@ class Viewer:
         now = time.perf_counter()
         elapsed = now - self._last_frame if dt is None else dt
         self._last_frame = now
+        self.physics.window_drawing(True)  # a physics thread far ahead leaves the GIL to the frame
+        try:
+            self._frame(now, elapsed, dt)
+        finally:
+            self.physics.window_drawing(False)
+
+    def _frame(self, now: float, elapsed: float, dt: float | None) -> None:
+        """``frame``'s work, with ``now`` and the ``elapsed`` real time it measured."""
         self.view.move(self.held, elapsed)
         self._queue_interaction((self.window.width, self.window.height), elapsed)
         if now >= self._watch_at:
