@@ -375,14 +375,16 @@ class Simulation:
         self._update_stats(frame_seconds, steps)
         return steps
 
-    def lead(self, steps: int) -> int:
+    def lead(self, steps: int, before_each: Callable[[], None] | None = None) -> int:
         """Take up to ``steps`` fixed steps now, whatever the wall clock: the physics thread running ahead
-        of what the window shows (stepper.py). The state is handed over as it is, not interpolated, and
-        the simulated time counted for the real-time factor is the time shown (``count_shown``), not
-        the time stepped. Returns the steps taken."""
+        of what the window shows (stepper.py), calling ``before_each`` before each step. The state is
+        handed over as it is, not interpolated, and the simulated time counted for the real-time factor
+        is the time shown (``count_shown``), not the time stepped. Returns the steps taken."""
         taken, stepped = 0, self._stats_sim
         contacts: list = []
         while taken < steps and (self.phase is Phase.RUNNING or self.held):
+            if before_each is not None:
+                before_each()
             self._step(contacts)
             taken += 1
         self._finish_steps(contacts)

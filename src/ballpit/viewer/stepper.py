@@ -65,7 +65,7 @@ window, coming back from a GL call, waits at most about a millisecond for the ph
 The window's frame first. Each GL call the window's thread makes lets go of the GIL, and coming back
 it waits for the physics thread to let go in turn, up to the switch interval: a frame of a hundred
 calls laid out beside a batch of steps is a hundred hand-overs. A run at least ``GATE_AHEAD`` s ahead
-of what the window shows has time to spare, so before each batch it waits (``GATE_WAIT`` at most)
+of what the window shows has time to spare, so before each step it waits (``GATE_WAIT`` at most)
 while the window's thread lays out a frame (``window_drawing``), and steps while the window waits
 for the rasteriser, for the display, or for its next frame. Behind that, it steps at once, as before.
 In three pairs while pile.toml landed (its physics 0.7-0.8 of a core) the window's thread took
@@ -112,7 +112,7 @@ LEAD_FRAME = 1.0 / 60.0
 # wait for the GIL when it comes back from a GL call while the physics holds it
 SWITCH_INTERVAL = 0.001
 GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach the main run's step
-# s: how far ahead of what the window shows the run must be for the thread to wait, before a batch,
+# s: how far ahead of what the window shows the run must be for the thread to wait, before each step
 # while the window's thread lays out a frame (at most GATE_WAIT s; see "The window's frame first")
 GATE_AHEAD = 0.5
 GATE_WAIT = 0.01
@@ -318,8 +318,6 @@ class PhysicsThread:
                 self._sleep(IDLE_WAIT)
                 continue
             wait = IDLE_WAIT
-            if self._ahead_by >= self.gate_ahead and not self._window_free.is_set():
-                self._sleep_until_drawn()
             with self.lock:
                 if not self._free or self._stopped:
                     continue
@@ -368,8 +366,11 @@ class PhysicsThread:
             if wait > 0.0:
                 self._sleep(min(wait, IDLE_WAIT))
 
-    def _sleep_until_drawn(self) -> None:
-        """Wait (by choice: idle) until the window's thread has laid out its frame, GATE_WAIT at most."""
+    def _leave_the_frame_first(self) -> None:
+        """Before each step taken ahead: far enough ahead, wait (by choice: idle) until the window's
+        thread has laid out its frame, GATE_WAIT at most."""
+        if self._ahead_by < self.gate_ahead or self._window_free.is_set():
+            return
         slept = time.perf_counter()
         self._window_free.wait(GATE_WAIT)
         self.idle_seconds += time.perf_counter() - slept
@@ -440,7 +441,7 @@ class PhysicsThread:
         if ahead >= self.lead:
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
-        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)))
+        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), self._leave_the_frame_first)
         state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale  # never, while held
