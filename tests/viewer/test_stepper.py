@@ -271,9 +271,10 @@ def _steps_while_drawing(physics: PhysicsThread, drawing: bool) -> float:
     return stepped / windows
 
 
-def test_a_run_far_ahead_waits_for_the_window_to_lay_out_its_frame_and_steps_in_between():
+def test_a_run_far_ahead_waits_for_the_window_to_lay_out_its_frame_and_steps_in_between(monkeypatch):
     # At 4 times real time and a 1/60 s step the thread needs a batch every 4 ms, so it steps in nearly
-    # every 5 ms window; far enough ahead, not while the window lays out a frame (GATE_WAIT: 10 ms).
+    # every 5 ms window; far enough ahead, not while the window lays out a frame (GATE_WAIT: 10 ms),
+    # unless it is busy stepping more than GATE_BUSY of the time (set here below what it needs).
     world = line_of_balls(1)
     sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))
     physics = PhysicsThread(sim, lead=2.0)
@@ -282,13 +283,17 @@ def test_a_run_far_ahead_waits_for_the_window_to_lay_out_its_frame_and_steps_in_
         physics.run_free()
         far = 2 * stepper.GATE_AHEAD * 4.0
         assert wait_for(lambda: sim.world.time - physics.shown.time > far, timeout=30.0)
+        monkeypatch.setattr(stepper, "GATE_BUSY", 1.0)  # however busy
         free = _steps_while_drawing(physics, drawing=False)
         laid_out = _steps_while_drawing(physics, drawing=True)
         assert sim.world.time - physics.shown.time > stepper.GATE_AHEAD * 4.0  # still far ahead
+        monkeypatch.setattr(stepper, "GATE_BUSY", -1.0)  # busier than that: it steps at once
+        busy = _steps_while_drawing(physics, drawing=True)
     finally:
         physics.stop()
     assert free >= 0.6, free
     assert laid_out <= 0.3, laid_out
+    assert busy >= 0.6, busy
 
 
 def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_thread():

@@ -65,12 +65,14 @@ window, coming back from a GL call, waits at most about a millisecond for the ph
 The window's frame first. Each GL call the window's thread makes lets go of the GIL, and coming back
 it waits for the physics thread to let go in turn, up to the switch interval: a frame of a hundred
 calls laid out beside a batch of steps is a hundred hand-overs. A run at least ``GATE_AHEAD`` s ahead
-of what the window shows has time to spare, so before each step it waits (``GATE_WAIT`` at most)
-while the window's thread lays out a frame (``window_drawing``), and steps while the window waits
-for the rasteriser, for the display, or for its next frame. Behind that, it steps at once, as before.
-In three pairs while pile.toml landed (its physics 0.7-0.8 of a core) the window's thread took
-5.9-6.1 ms of CPU a frame against 6.7-7.3, llvmpipe's 12.6-13.2 against 13.3-15.3, the physics 0.71
-of a core against 0.73-0.83 for the same steps, shown at the same 0.997-1.000 of real time.
+of what the window shows, stepping at most ``GATE_BUSY`` of the time, has time to spare, so before
+each step it waits (``GATE_WAIT`` at most) while the window's thread lays out a frame
+(``window_drawing``), and steps while the window waits for the rasteriser, for the display, or for
+its next frame. Otherwise it steps at once, as before: a physics busy nearly all the time made to
+wait falls behind, and the window then draws less to give it the CPU back (pile.toml after its
+landing: 42.1-44.7 FPS against 45.9-52.7 in 4 pairs when it waited too). The slopes with ghosts, 6
+pairs in a slow spell of the host: landing at 50.0, 41.8, 45.3, 50.1, 54.3, 58.7 FPS against 48.1,
+40.0, 50.9, 40.1, 31.3, 41.0, the window's thread at 3.1-6.0 ms of CPU a frame against 4.9-7.5.
 
 The integrator ghosts are the exception (``ghosts_apart``, the viewer's default; ghostproc.py): their
 three worlds are stepped in a process of their own. They depend on nothing the main run does after
@@ -116,6 +118,7 @@ GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach 
 # while the window's thread lays out a frame (at most GATE_WAIT s; see "The window's frame first")
 GATE_AHEAD = 0.5
 GATE_WAIT = 0.01
+GATE_BUSY = 0.7  # ... and only while it steps at most this share of the time (pacing.BUSY_FAST)
 HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
 HOLD_SECONDS = 3.0  # s of wall time a hold steps at most (pile.toml: 1.2-1.4 s for its 1.5 s)
 HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
@@ -369,7 +372,7 @@ class PhysicsThread:
     def _leave_the_frame_first(self) -> None:
         """Before each step taken ahead: far enough ahead, wait (by choice: idle) until the window's
         thread has laid out its frame, GATE_WAIT at most."""
-        if self._ahead_by < self.gate_ahead or self._window_free.is_set():
+        if self._ahead_by < self.gate_ahead or self.busy_fraction > GATE_BUSY or self._window_free.is_set():
             return
         slept = time.perf_counter()
         self._window_free.wait(GATE_WAIT)
