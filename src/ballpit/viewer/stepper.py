@@ -159,7 +159,7 @@ class PhysicsThread:
         gate_ahead: float = GATE_AHEAD,
     ) -> None:
         self.sim = sim
-        self.gate_ahead = gate_ahead  # s ahead from which a batch waits for the window's frame
+        self.gate_ahead = gate_ahead  # s ahead from which each step waits for the window's frame
         self.hold = hold  # a waiting scene is held, its first lead stepped before X
         if ghosts_apart:  # the integrator ghosts' worlds in a process of their own (ghostproc.py)
             sim.ghosts_apart()
