@@ -96,6 +96,7 @@ from dataclasses import replace
 from typing import Any
 
 from .handover import HudFacts, Needs, Shown, capture
+from .pacing import BUSY_FAST
 from .simulation import Phase, Simulation
 
 HUD_INTERVAL = 0.1  # seconds between readings of the HUD's facts (energy, drifts, profile)
@@ -118,7 +119,7 @@ GHOST_WAIT = 120.0  # s lockstep waits at most for the ghosts' process to reach 
 # while the window's thread lays out a frame (at most GATE_WAIT s; see "The window's frame first")
 GATE_AHEAD = 0.5
 GATE_WAIT = 0.01
-GATE_BUSY = 0.7  # ... and only while it steps at most this share of the time (pacing.BUSY_FAST)
+GATE_BUSY = BUSY_FAST  # ... and only while it steps at most this share of the time: the pacer's full rate
 HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
 HOLD_SECONDS = 3.0  # s of wall time a hold steps at most (pile.toml: 1.2-1.4 s for its 1.5 s)
 HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
@@ -180,7 +181,6 @@ class PhysicsThread:
         self._wake = threading.Event()
         self._window_free = threading.Event()  # clear while the window's thread lays out a frame
         self._window_free.set()
-        self._ahead_by = 0.0  # s of wall time the run was ahead of the window at the last batch
         self._free = False
         self._restart_clock = True
         self._stopped = False
@@ -346,7 +346,6 @@ class PhysicsThread:
                         last = published = now
                     else:
                         self._base = None
-                        self._ahead_by = 0.0
                         steps = self.sim.advance(now - last)
                         last = now
                         news = self.sim.timeline.take_ghost_news()  # a seek's ghosts came, say
@@ -370,19 +369,20 @@ class PhysicsThread:
                 self._sleep(min(wait, IDLE_WAIT))
 
     def _leave_the_frame_first(self) -> None:
-        """Before each step taken ahead: far enough ahead, wait (by choice: idle) until the window's
-        thread has laid out its frame, GATE_WAIT at most."""
-        if self._ahead_by < self.gate_ahead or self.busy_fraction > GATE_BUSY or self._window_free.is_set():
-            return
-        slept = time.perf_counter()
-        self._window_free.wait(GATE_WAIT)
-        self.idle_seconds += time.perf_counter() - slept
+        """Before each step of a batch taken far ahead: unless the thread is busy, wait (by choice)
+        until the window's thread has laid out its frame, GATE_WAIT at most."""
+        if self.busy_fraction <= GATE_BUSY and not self._window_free.is_set():
+            self._idle(self._window_free, GATE_WAIT)
 
     def _sleep(self, seconds: float) -> None:
         """Wait until ``seconds`` pass or a command comes, counting the time as idle."""
-        slept = time.perf_counter()
-        self._wake.wait(seconds)
+        self._idle(self._wake, seconds)
         self._wake.clear()
+
+    def _idle(self, event: threading.Event, seconds: float) -> None:
+        """Wait for ``event`` at most ``seconds``, the time counted as slept by choice."""
+        slept = time.perf_counter()
+        event.wait(seconds)
         self.idle_seconds += time.perf_counter() - slept
 
     def _measure_busy(self) -> None:
@@ -440,11 +440,11 @@ class PhysicsThread:
         ahead = (sim.world.time - shown) / scale
         if held and (ahead >= self.lead or self._held_seconds >= HOLD_SECONDS):
             return IDLE_WAIT  # held as far as it goes: nothing is due until X
-        self._ahead_by = 0.0 if held else ahead
         if ahead >= self.lead:
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
-        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), self._leave_the_frame_first)
+        far = not held and ahead >= self.gate_ahead  # time to spare: the window's frame first
+        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), self._leave_the_frame_first if far else None)
         state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale  # never, while held
