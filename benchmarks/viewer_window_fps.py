@@ -13,8 +13,8 @@ Per scene, medians over the runs of:
   real time; the time is that of the state the window shows, not of the World, which may be stepped
   up to ``stepper.LEAD_SECONDS`` ahead of it), ``hud_rtf`` and ``hud_rtf_min`` the median and
   lowest real-time factor the HUD showed meanwhile (read every 0.25 s from 0.75 s after X);
-- ``fps_after_x``, ``steps_per_second`` and ``real_time_factor`` (the HUD's) over ``--seconds`` from
-  one second after the landing;
+- ``fps_after_x``, ``steps_per_second`` (of the states shown) and ``real_time_factor`` (the HUD's)
+  over ``--seconds`` from one second after the landing;
 - with ``--threads``, the CPU each kind of thread used while the pile landed, in cores: the physics
   thread, the integrator ghosts' process (ghostproc.py; ``cpu_ghosts``), the window's (main) thread,
   llvmpipe's rasteriser threads and the rest; ``physics_cpu_per_sim_s`` counts the physics thread and
@@ -111,7 +111,9 @@ def mark():
 
 
 def sim_steps():
-    return getattr(viewer.physics, "steps_total", None) or sim.steps_total
+    # the step of the state the window shows (the physics may have stepped it long before: held before X)
+    shown = viewer.physics.shown.step
+    return shown if shown is not None else sim.steps_total
 
 
 def sim_time():

@@ -115,10 +115,10 @@ def test_steps_slower_than_real_time_follow_each_other_without_a_pause():
 def test_the_busy_share_is_near_zero_while_nothing_steps_and_near_one_while_steps_run_late():
     world = line_of_balls(3)
     sim = Simulation(Scene(world, default_appearance(world), timestep=1.0 / 60.0))
-    physics = PhysicsThread(sim)
+    physics = PhysicsThread(sim, hold=False)
     try:
         physics.run_free()
-        time.sleep(1.2)  # waiting for X: it only sleeps
+        time.sleep(1.2)  # waiting for X, not held: it only sleeps
         waiting = physics.busy_fraction
         sim.before_step.append(lambda: time.sleep(0.03))  # every 1/60 s step takes 30 ms
         physics.submit(lambda s: s.start())
@@ -300,12 +300,13 @@ def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_
     """The lead, the switch interval and where the ghosts run."""
     defaults = {"lead": stepper.LEAD_SECONDS, "switch_interval": stepper.SWITCH_INTERVAL}
     defaults |= {"ghosts_apart": True, "hold": True, "gate_ahead": stepper.GATE_AHEAD}
+    defaults |= {"hold_reach": stepper.HOLD_REACH}
     assert stepper.tuning_from({}) == defaults
     environ = {"BALLPIT_LEAD": "0", "BALLPIT_SWITCH": "0.002", "BALLPIT_GHOSTS": "thread"}
-    environ |= {"BALLPIT_HOLD": "0", "BALLPIT_GATE": "inf"}
+    environ |= {"BALLPIT_HOLD": "0", "BALLPIT_GATE": "inf", "BALLPIT_HOLD_REACH": "3"}
     tuned = stepper.tuning_from(environ)
     assert tuned == {"lead": 0.0, "switch_interval": 0.002, "ghosts_apart": False, "hold": False,
-                     "gate_ahead": math.inf}  # fmt: skip
+                     "gate_ahead": math.inf, "hold_reach": 3.0}  # fmt: skip
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, **tuned)
     try:
@@ -429,3 +430,80 @@ def test_a_waiting_scene_is_held_though_the_file_watch_asks_every_tenth_of_a_sec
         assert _held(physics)
     finally:
         physics.stop()
+
+
+def _held_to(physics: PhysicsThread, seconds: float) -> bool:
+    """The scene waits for X with ``seconds`` of its drop stepped."""
+    sim = physics.sim
+    return sim.held and sim.world.time >= seconds - 1e-9 and not physics._commands
+
+
+def test_a_small_scene_is_held_to_its_reach_and_shown_from_x_without_a_step_while_the_queue_lasts():
+    # held 4 s into its drop: after X the first 2.5 s are shown from the queue (it stays a lead of
+    # 1.5 s ahead), the thread taking no step, and the HUD counts the steps it shows
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim, hold_reach=4.0)
+    try:
+        physics.run_free()
+        assert wait_for(lambda: _held_to(physics, 4.0))
+        time.sleep(0.2)
+        assert sim.world.time <= 4.0 + stepper.LEAD_FRAME + 1e-9  # no further than its reach
+        steps = sim.steps_total
+        physics.submit(lambda s: s.start(), rewind=False)
+        pressed = time.perf_counter()
+        assert wait_for(lambda: physics.shown.time >= 1.5)
+        shown, wall = physics.shown, time.perf_counter() - pressed
+        taken, rate = sim.steps_total - steps, sim.steps_per_second
+    finally:
+        physics.stop()
+    assert taken == 0
+    assert shown.time == pytest.approx(wall, abs=0.05)  # shown from X at real speed
+    assert rate == pytest.approx(1.0 / sim.timestep, rel=0.1)
+    fresh = line_of_balls(3)
+    while fresh.time < shown.time - 0.5 * sim.timestep:
+        fresh.step(sim.timestep)
+    np.testing.assert_array_equal(shown.positions, fresh.spheres.positions)
+
+
+def test_a_hold_queues_no_more_states_than_its_memory_allows(monkeypatch):
+    # a budget of 2 s of this scene's queued states: held 2 s into its drop, not its 10 s reach
+    per_second = (stepper.QUEUED_BYTES + 3 * stepper.QUEUED_BYTES_PER_BALL) / stepper.LEAD_FRAME
+    monkeypatch.setattr(stepper, "HOLD_MEMORY", 2.0 * per_second)
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim, hold_reach=10.0)
+    try:
+        physics.run_free()
+        assert wait_for(lambda: _held_to(physics, 2.0))
+        time.sleep(0.3)
+        held, queued = sim.world.time, len(physics._ahead)
+    finally:
+        physics.stop()
+    assert held <= 2.0 + stepper.LEAD_FRAME + 1e-9
+    assert queued <= round(2.0 / stepper.LEAD_FRAME) + 1
+
+
+@pytest.mark.slow  # the ghosts' process
+def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step():
+    # the run held 10 s ahead of what is shown, the ghosts' process further still: the frames of the
+    # steps shown are still kept when the window comes to them
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim, ghosts_apart=True, hold_reach=10.0)
+    try:
+        physics.submit(lambda s: s.toggle_ghosts())
+        physics.run_free()
+        assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=60)
+        history, host = sim.timeline.history, sim.ghost_host
+        assert wait_for(lambda: (host.reached or 0) >= history.current, timeout=120)
+        physics.submit(lambda s: s.start(), rewind=False)
+        seen = set()
+        while len(seen) < 20:
+            shown = physics.shown
+            shown.resolve_ghosts()
+            assert shown.ghosts is not None and shown.ghost_step == shown.step
+            seen.add(shown.step)
+            time.sleep(0.05)
+    finally:
+        physics.stop()
+        host = sim.ghost_host
+        if host is not None:
+            host._process.wait(timeout=10)

@@ -49,7 +49,9 @@ REAP_WAIT = 5.0  # s a closed child has to end before it is killed
 TELL_EVERY = 1 / 32  # of the child's reach: how far the main run gets on between two "to" messages
 BATCH = 4  # steps taken between looks at the pipe (one message back for them)
 BODY_BUDGET = 400  # balls × ghosts sent with every step; beyond it, poses every 4 steps
-KEEP_FRAMES = 2048  # frames kept on the main side (about 8 s at 240 steps a second)
+# frames kept on the main side (about 17 s at 240 steps a second): the ones the window shows, those
+# up to the main run's latest step (stepper.HOLD_REACH ahead of them before X) and AHEAD past it
+KEEP_FRAMES = 4096
 BODY_MEMORY = 64 << 20  # bytes of balls' poses kept at most on the main side (64 a ball per ghost)
 # The child's niceness: when the window, the main run and the ghosts want more than the cores, the
 # window's frames and the main run's real time come first and the ghosts fall behind (drawn at the
@@ -312,7 +314,9 @@ class RemoteGhosts(GhostRun):
         super().__init__(spec)
         self.host = host
         self.target = spec.target  # the main run's latest step, as far as the child was told
-        self.ahead = reach(spec)[0]  # steps the child steps past it
+        self.ahead, every, keep = reach(spec)  # steps the child steps past it, ...
+        # the frames kept reach from the one shown to the child's latest, ``ahead`` past the main run's
+        self.span = min(keep * every, KEEP_FRAMES) - self.ahead
         self._told = spec.target
         self._on = True
         host.start(spec)

@@ -94,6 +94,9 @@ class GhostRun:
 
     remote = False  # stepped in another process: their frames come later than the main run's steps
     error: str | None = None  # what stopped them (a ghost world failed where they are stepped)
+    # steps the main run may be ahead of the step the window shows with the ghosts' frames of both kept
+    # (stepped here, they are stepped with it: no limit)
+    span: float = float("inf")
 
     def __init__(self, spec: GhostSpec) -> None:
         self.integrators = spec.integrators

@@ -378,9 +378,10 @@ class Simulation:
     def lead(self, steps: int, before_each: Callable[[], None] | None = None) -> int:
         """Take up to ``steps`` fixed steps now, whatever the wall clock: the physics thread running ahead
         of what the window shows (stepper.py), calling ``before_each`` before each step. The state is
-        handed over as it is, not interpolated, and the simulated time counted for the real-time factor
-        is the time shown (``count_shown``), not the time stepped. Returns the steps taken."""
-        taken, stepped = 0, self._stats_sim
+        handed over as it is, not interpolated, and the simulated time and steps counted for the
+        real-time factor and the steps per second are those shown (``count_shown``), not those stepped
+        (which come in bursts, taken before X when the scene was held). Returns the steps taken."""
+        taken, stepped, counted = 0, self._stats_sim, self._stats_steps
         contacts: list = []
         while taken < steps and (self.phase is Phase.RUNNING or self.held):
             if before_each is not None:
@@ -388,7 +389,7 @@ class Simulation:
             self._step(contacts)
             taken += 1
         self._finish_steps(contacts)
-        self._stats_sim = stepped
+        self._stats_sim, self._stats_steps = stepped, counted
         self.accumulator, self.alpha = 0.0, 1.0
         if taken:
             self.timeline.sample_energy()
@@ -396,8 +397,10 @@ class Simulation:
 
     def count_shown(self, wall_seconds: float, shown_seconds: float) -> None:
         """While running ahead: ``wall_seconds`` passed and the window's state moved on by
-        ``shown_seconds`` of simulated time (the real-time factor is the speed the run is shown at)."""
+        ``shown_seconds`` of simulated time (the real-time factor is the speed the run is shown at, the
+        steps per second those it shows)."""
         self._stats_sim += shown_seconds
+        self._stats_steps += shown_seconds / self.timestep
         self._update_stats(wall_seconds, 0)
         if self.real_time_factor == 0.0 and self._stats_wall >= 0.2 * STATS_WINDOW:  # before the first end
             self.real_time_factor = self._stats_sim / self._stats_wall

@@ -36,10 +36,15 @@ and the run goes on from there, as resuming from the past does.
 
 Held before X. While a scene waits for X and nothing is asked of the thread (for ``HOLD_QUIET``),
 the drop is started but held at its first state (``Simulation.hold``): the thread steps the first
-``lead`` of it, as it runs ahead after X, and queues the states without a due time, while the window goes on
-showing the first one. X lets it go (``Simulation.start``, a command that does not rewind): the
-queued states get their due times from that instant, so the run starts with its lead already taken
-instead of building it meanwhile. pile.toml's landing costs more than the physics thread gets beside
+``hold_reach`` of it (HOLD_REACH, 10 s; less where the states queued would take more than
+HOLD_MEMORY, never less than the lead) and queues the states without a due time, while the window
+goes on showing the first one. Past the lead, each step waits first while the window lays out a frame:
+the scene before X is drawn as often as ever. X lets it go (``Simulation.start``, a command that does
+not rewind): the queued states get their due times from that instant, so the run starts with its lead
+already taken instead of building it meanwhile, and a small scene's first seconds are shown without a
+step taken beside them (the thread steps again once the queue is down to the lead): the slopes with
+their ghosts landed at 59.0-60.2 FPS with the physics at 0.005 of a core, against 55.4-59.1 FPS and
+0.25-0.38 held a lead (docs/benchmarks.md). pile.toml's landing costs more than the physics thread gets beside
 the window; from a lead built during its 0.6 s fall it was shown at 0.76-0.99 of real time. Anything
 else asked before X undoes the hold first (``Simulation.unhold``: the world back at its first state,
 bit for bit, waiting as before), then is done; the hold starts again once the thread is left alone.
@@ -123,6 +128,15 @@ GATE_BUSY = BUSY_FAST  # ... and only while it steps at most this share of the t
 HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
 HOLD_SECONDS = 3.0  # s of wall time a hold steps at most (pile.toml: 1.2-1.4 s for its 1.5 s)
 HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
+# s of simulated time a hold steps ahead at most (see "Held before X"), and bytes the states it queues
+# may take: each keeps a snapshot to go back to (History.mark; pile.toml's: 556 B a ball pickled) and a
+# hand-over (the balls' poses and colours, about 150 B a ball, and the panel's copies of its plots'
+# traces: the slopes' 600 states held 19 MB). The slopes' balls come to rest 5.5 s into their drop;
+# pile.toml's 96 MB reach 1.9 s of it
+HOLD_REACH = 10.0
+HOLD_MEMORY = 96 << 20
+QUEUED_BYTES_PER_BALL = 720
+QUEUED_BYTES = 32 << 10
 
 
 def tuning_from(environ: Mapping[str, str]) -> dict[str, Any]:
@@ -130,12 +144,14 @@ def tuning_from(environ: Mapping[str, str]) -> dict[str, Any]:
     the thread, and passed in): ``BALLPIT_LEAD`` (s; 0 holds the physics to the wall clock),
     ``BALLPIT_SWITCH`` (s), each LEAD_SECONDS and SWITCH_INTERVAL when not set, and ``BALLPIT_GHOSTS``
     (``process``, the default, or ``thread``: the integrator ghosts stepped on this thread),
-    ``BALLPIT_HOLD`` (``0``: no hold before X) and ``BALLPIT_GATE`` (s, GATE_AHEAD when not set; ``inf``:
-    the thread never waits for the window's frame)."""
+    ``BALLPIT_HOLD`` (``0``: no hold before X), ``BALLPIT_HOLD_REACH`` (s, HOLD_REACH when not set)
+    and ``BALLPIT_GATE`` (s, GATE_AHEAD when not set; ``inf``: the thread never waits for the window's
+    frame)."""
     return {
         "lead": float(environ.get("BALLPIT_LEAD", LEAD_SECONDS)),
         "gate_ahead": float(environ.get("BALLPIT_GATE", GATE_AHEAD)),
         "hold": environ.get("BALLPIT_HOLD", "1") != "0",
+        "hold_reach": float(environ.get("BALLPIT_HOLD_REACH", HOLD_REACH)),
         "switch_interval": float(environ.get("BALLPIT_SWITCH", SWITCH_INTERVAL)),
         "ghosts_apart": environ.get("BALLPIT_GHOSTS", "process") != "thread",
     }
@@ -158,8 +174,10 @@ class PhysicsThread:
         ghosts_apart: bool = False,
         hold: bool = True,
         gate_ahead: float = GATE_AHEAD,
+        hold_reach: float = HOLD_REACH,
     ) -> None:
         self.sim = sim
+        self.hold_reach = hold_reach  # s of its drop a waiting scene's hold steps at most
         self.gate_ahead = gate_ahead  # s ahead from which each step waits for the window's frame
         self.hold = hold  # a waiting scene is held, its first lead stepped before X
         if ghosts_apart:  # the integrator ghosts' worlds in a process of their own (ghostproc.py)
@@ -374,6 +392,12 @@ class PhysicsThread:
         if self.busy_fraction <= GATE_BUSY and not self._window_free.is_set():
             self._idle(self._window_free, GATE_WAIT)
 
+    def _after_the_frame(self) -> None:
+        """Before each step held past the lead: wait (by choice) until the window's thread has laid out
+        its frame, GATE_WAIT at most."""
+        if not self._window_free.is_set():
+            self._idle(self._window_free, GATE_WAIT)
+
     def _sleep(self, seconds: float) -> None:
         """Wait until ``seconds`` pass or a command comes, counting the time as idle."""
         self._idle(self._wake, seconds)
@@ -438,13 +462,16 @@ class PhysicsThread:
         # the simulated time shown now
         shown = sim0 if held else min(sim0 + (now - wall0) * scale, sim.world.time)
         ahead = (sim.world.time - shown) / scale
-        if held and (ahead >= self.lead or self._held_seconds >= HOLD_SECONDS):
+        if held and (ahead >= self._reach() or self._held_seconds >= HOLD_SECONDS):
             return IDLE_WAIT  # held as far as it goes: nothing is due until X
-        if ahead >= self.lead:
+        if not held and ahead >= self.lead:
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
-        far = not held and ahead >= self.gate_ahead  # time to spare: the window's frame first
-        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), self._leave_the_frame_first if far else None)
+        if held:  # past the lead, the window's frame first: X may be far off
+            first = self._after_the_frame if ahead >= self.lead else None
+        else:  # far ahead, with time to spare: the window's frame first
+            first = self._leave_the_frame_first if ahead >= self.gate_ahead else None
+        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), first)
         state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale  # never, while held
@@ -479,6 +506,17 @@ class PhysicsThread:
             and not self._commands
             and now - self._asked_at >= HOLD_QUIET
         )
+
+    def _reach(self) -> float:
+        """How far ahead the hold steps: ``hold_reach``, less where the states it queues would take more
+        than HOLD_MEMORY or the ghosts' frames kept would not cover them, never less than the lead."""
+        sim = self.sim
+        queued = (QUEUED_BYTES + sim.ball_count * QUEUED_BYTES_PER_BALL) / LEAD_FRAME  # a simulated s
+        reach = min(self.hold_reach, HOLD_MEMORY / queued)
+        ghosts = sim.timeline.ghosts
+        if ghosts is not None:
+            reach = min(reach, ghosts.span * sim.timestep)
+        return max(reach, self.lead)
 
     def _start_hold(self) -> None:
         """Hold the drop: the state shown now is its first (step 0 of the history it starts)."""
