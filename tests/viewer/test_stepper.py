@@ -484,16 +484,18 @@ def test_a_hold_queues_no_more_states_than_its_memory_allows(monkeypatch):
 
 @pytest.mark.slow  # the ghosts' process
 def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step():
-    # the run held 10 s ahead of what is shown, the ghosts' process further still: the frames of the
-    # steps shown are still kept when the window comes to them
+    # the run held 10 s ahead of what is shown, the ghosts' process further still: each state queued
+    # was captured with the ghosts (and their energies, for the HUD) of its own step, and the frames of
+    # the steps shown are still kept when the window comes to them
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, ghosts_apart=True, hold_reach=10.0)
     try:
         physics.submit(lambda s: s.toggle_ghosts())
         physics.run_free()
-        assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=60)
-        history, host = sim.timeline.history, sim.ghost_host
-        assert wait_for(lambda: (host.reached or 0) >= history.current, timeout=120)
+        assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=120)
+        with physics._handover_lock:
+            queued = [state for _, state in physics._ahead]
+        assert len(queued) >= 500 and all(state.ghost_step == state.step for state in queued)
         physics.submit(lambda s: s.start(), rewind=False)
         seen = set()
         while len(seen) < 20:
@@ -507,3 +509,15 @@ def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step():
         host = sim.ghost_host
         if host is not None:
             host._process.wait(timeout=10)
+
+
+def test_a_hold_with_the_ghosts_stepped_on_its_own_thread_reaches_as_far_as_without_them():
+    sim = Simulation(line_of_balls(3))
+    physics = PhysicsThread(sim, ghosts_apart=False, hold_reach=3.0)
+    try:
+        physics.submit(lambda s: s.toggle_ghosts())
+        physics.run_free()
+        assert wait_for(lambda: _held_to(physics, 3.0))
+        assert not sim.timeline.ghosts.remote
+    finally:
+        physics.stop()

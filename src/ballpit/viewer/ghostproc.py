@@ -358,6 +358,10 @@ class RemoteGhosts(GhostRun):
         return self.host.frame_at(step, wait)
 
     @property
+    def reached(self) -> int | None:
+        return self.host.reached
+
+    @property
     def error(self) -> str | None:
         return self.host.error
 

@@ -38,8 +38,10 @@ Held before X. While a scene waits for X and nothing is asked of the thread (for
 the drop is started but held at its first state (``Simulation.hold``): the thread steps the first
 ``hold_reach`` of it (HOLD_REACH, 10 s; less where the states queued would take more than
 HOLD_MEMORY, never less than the lead) and queues the states without a due time, while the window
-goes on showing the first one. Past the lead, each step waits first while the window lays out a frame:
-the scene before X is drawn as often as ever. X lets it go (``Simulation.start``, a command that does
+goes on showing the first one. The run goes no further than the integrator ghosts have reached in
+their process (each state queued shows them, and the HUD their energies, at its own step), and past
+the lead each step waits first while the window lays out a frame (the scene before X is drawn as often
+as ever). X lets it go (``Simulation.start``, a command that does
 not rewind): the queued states get their due times from that instant, so the run starts with its lead
 already taken instead of building it meanwhile, and a small scene's first seconds are shown without a
 step taken beside them (the thread steps again once the queue is down to the lead): the slopes with
@@ -464,6 +466,8 @@ class PhysicsThread:
         ahead = (sim.world.time - shown) / scale
         if held and (ahead >= self._reach() or self._held_seconds >= HOLD_SECONDS):
             return IDLE_WAIT  # held as far as it goes: nothing is due until X
+        if held and self._ghosts_behind():
+            return IDLE_WAIT  # no further than the ghosts: each state queued has theirs
         if not held and ahead >= self.lead:
             self._count_shown(now, shown)
             return min(ahead - self.lead + 1e-3, IDLE_WAIT)
@@ -517,6 +521,15 @@ class PhysicsThread:
         if ghosts is not None:
             reach = min(reach, ghosts.span * sim.timestep)
         return max(reach, self.lead)
+
+    def _ghosts_behind(self) -> bool:
+        """The ghosts, stepped in their own process, have not reached the step of the run's next batch."""
+        sim = self.sim
+        ghosts, history = sim.timeline.ghosts, sim.timeline.history
+        if ghosts is None or not ghosts.remote or history is None:  # stepped here, with the run
+            return False
+        reached = ghosts.reached
+        return reached is None or reached < history.current + max(1, round(LEAD_FRAME / sim.timestep))
 
     def _start_hold(self) -> None:
         """Hold the drop: the state shown now is its first (step 0 of the history it starts)."""
