@@ -438,9 +438,12 @@ def _held_to(physics: PhysicsThread, seconds: float) -> bool:
     return sim.held and sim.world.time >= seconds - 1e-9 and not physics._commands
 
 
-def test_a_small_scene_is_held_to_its_reach_and_shown_from_x_without_a_step_while_the_queue_lasts():
+def test_a_small_scene_is_held_to_its_reach_and_shown_from_x_without_a_step_while_the_queue_lasts(
+    monkeypatch,
+):
     # held 4 s into its drop: after X the first 2.5 s are shown from the queue (it stays a lead of
     # 1.5 s ahead), the thread taking no step, and the HUD counts the steps it shows
+    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)  # however long a loaded machine takes
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, hold_reach=4.0)
     try:
@@ -469,6 +472,7 @@ def test_a_hold_queues_no_more_states_than_its_memory_allows(monkeypatch):
     # a budget of 2 s of this scene's queued states: held 2 s into its drop, not its 10 s reach
     per_second = (stepper.QUEUED_BYTES + 3 * stepper.QUEUED_BYTES_PER_BALL) / stepper.LEAD_FRAME
     monkeypatch.setattr(stepper, "HOLD_MEMORY", 2.0 * per_second)
+    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, hold_reach=10.0)
     try:
@@ -483,20 +487,22 @@ def test_a_hold_queues_no_more_states_than_its_memory_allows(monkeypatch):
 
 
 @pytest.mark.slow  # the ghosts' process
-def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step():
+def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step(monkeypatch):
     # the run held 10 s ahead of what is shown, the ghosts' process further still: each state queued
     # was captured with the ghosts (and their energies, for the HUD) of its own step, and the frames of
     # the steps shown are still kept when the window comes to them
+    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, ghosts_apart=True, hold_reach=10.0)
     try:
         physics.submit(lambda s: s.toggle_ghosts())
         physics.run_free()
-        assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=120)
+        assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=300)
         with physics._handover_lock:
             queued = [state for _, state in physics._ahead]
         assert len(queued) >= 500 and all(state.ghost_step == state.step for state in queued)
         physics.submit(lambda s: s.start(), rewind=False)
+        assert wait_for(lambda: physics.shown.time > 0.0)  # X applied: the queued states come due
         seen = set()
         while len(seen) < 20:
             shown = physics.shown
@@ -511,7 +517,8 @@ def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step():
             host._process.wait(timeout=10)
 
 
-def test_a_hold_with_the_ghosts_stepped_on_its_own_thread_reaches_as_far_as_without_them():
+def test_a_hold_with_the_ghosts_stepped_on_its_own_thread_reaches_as_far_as_without_them(monkeypatch):
+    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
     sim = Simulation(line_of_balls(3))
     physics = PhysicsThread(sim, ghosts_apart=False, hold_reach=3.0)
     try:

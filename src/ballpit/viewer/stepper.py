@@ -195,7 +195,7 @@ class PhysicsThread:
         self._counted = (0.0, 0.0)  # (wall, simulated time shown) when the factor was last fed
         self._rewind = False  # the window asked for the state it shows (what it draws changed)
         self._holding = False  # the Simulation is held before X by this thread
-        self._held_seconds = 0.0  # wall s the hold has stepped
+        self._held_seconds = 0.0  # wall s the hold has stepped (not counting its waits for the window)
         self._asked_at = time.perf_counter()  # when a command last came
         self._results: deque[tuple[Then, Any]] = deque()
         self._wake = threading.Event()
@@ -475,7 +475,9 @@ class PhysicsThread:
             first = self._after_the_frame if ahead >= self.lead else None
         else:  # far ahead, with time to spare: the window's frame first
             first = self._leave_the_frame_first if ahead >= self.gate_ahead else None
+        waited = self.idle_seconds
         sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), first)
+        waited = self.idle_seconds - waited  # for the window's frame, before steps
         state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
         due = wall0 + (state.time - sim0) / scale  # never, while held
@@ -484,7 +486,7 @@ class PhysicsThread:
         else:  # ahead: a command may come back to it
             history.mark()
         if held:
-            self._held_seconds += done - now
+            self._held_seconds += done - now - waited
         else:
             wall0, sim0 = self._base
             self._count_shown(done, min(sim0 + (done - wall0) * scale, state.time))
