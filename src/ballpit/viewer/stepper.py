@@ -37,23 +37,21 @@ and the run goes on from there, as resuming from the past does.
 Held before X. While a scene waits for X and nothing is asked of the thread (for ``HOLD_QUIET``),
 the drop is started but held at its first state (``Simulation.hold``): the thread steps the first
 ``hold_reach`` of it (HOLD_REACH, 10 s; less where the states queued would take more than
-HOLD_MEMORY, never less than the lead) and queues the states without a due time, while the window
-goes on showing the first one. The run goes no further than the integrator ghosts have reached in
-their process (each state queued shows them, and the HUD their energies, at its own step), and past
-the lead each step waits first while the window lays out a frame (the scene before X is drawn as often
-as ever). X lets it go (``Simulation.start``, a command that does
-not rewind): the queued states get their due times from that instant, so the run starts with its lead
-already taken instead of building it meanwhile, and a small scene's first seconds are shown without a
-step taken beside them (the thread steps again once the queue is down to the lead): the slopes with
-their ghosts landed at 59.0-60.2 FPS with the physics at 0.005 of a core, against 55.4-59.1 FPS and
-0.25-0.38 held a lead (docs/benchmarks.md). pile.toml's landing costs more than the physics thread gets beside
-the window; from a lead built during its 0.6 s fall it was shown at 0.76-0.99 of real time. Anything
-else asked before X undoes the hold first (``Simulation.unhold``: the world back at its first state,
-bit for bit, waiting as before), then is done; the hold starts again once the thread is left alone.
-The integrator ghosts, if on, start with the hold too, so their process steps its first seconds
-before X instead of beside the landing. Scenes of more than ``HOLD_MAX_BALLS`` balls are not held
-(a batch of their steps would keep the window's commands waiting), and a hold stops after
-``HOLD_SECONDS`` of stepping.
+HOLD_MEMORY) and queues the states without a due time, while the window goes on showing the first
+one. The run goes no further than the integrator ghosts have reached in their process (each state
+queued shows them, and the HUD their energies, at its own step), and past the lead each step waits
+first while the window lays out a frame (the scene before X is drawn as often as ever). X lets it go
+(``Simulation.start``, a command that does not rewind): the queued states get their due times from
+that instant, so the run starts with its lead already taken instead of building it meanwhile, and a
+scene's first seconds are shown without a step taken beside them (the thread steps again once the
+queue is down to the lead): the slopes with their ghosts landed at 58.6-59.9 FPS with the physics at
+0.005 of a core, against 55.3-59.4 FPS and 0.24-0.33 held 1.5 s; pile.toml, held past its landing, at
+59.3-59.5 against 46.8-49.8 held 1.9 s (docs/benchmarks.md). Anything else asked before X undoes the
+hold first (``Simulation.unhold``: the world back at its first state, bit for bit, waiting as
+before), then is done; the hold starts again once the thread is left alone. The integrator ghosts,
+if on, start with the hold too. Scenes of more than ``HOLD_MAX_BALLS`` balls are not held (a batch of
+their steps would keep the window's commands waiting), and a hold stops after ``HOLD_SECONDS`` of
+stepping.
 
 A thread rather than a process. First by benchmarks/physics_beside_drawing.py on a 2-core machine
 with a CPU rasteriser (2026-12-02, heavily loaded): while pile.toml lands, 9.3 and 8.7 frames/s with
@@ -128,7 +126,8 @@ GATE_AHEAD = 0.5
 GATE_WAIT = 0.01
 GATE_BUSY = BUSY_FAST  # ... and only while it steps at most this share of the time: the pacer's full rate
 HOLD_QUIET = 0.3  # s with no command before a waiting scene is held (see "Held before X")
-HOLD_SECONDS = 3.0  # s of wall time a hold steps at most (pile.toml: 1.2-1.4 s for its 1.5 s)
+# s of wall time a hold steps at most (not counting its waits): pile.toml's 3.6 s took 4-6 s of it
+HOLD_SECONDS = 8.0
 HOLD_MAX_BALLS = 20_000  # balls a scene may have to be held
 # s of simulated time a hold steps ahead at most (see "Held before X"), and bytes the states it queues
 # may take: each keeps a snapshot to go back to (History.mark; pile.toml's: 556 B a ball pickled) and a
@@ -516,14 +515,15 @@ class PhysicsThread:
 
     def _reach(self) -> float:
         """How far ahead the hold steps: ``hold_reach``, less where the states it queues would take more
-        than HOLD_MEMORY or the ghosts' frames kept would not cover them, never less than the lead."""
+        than HOLD_MEMORY (pile10k.toml: 0.4 s, its 26 snapshots 150 MB) or the ghosts' frames kept would
+        not cover them."""
         sim = self.sim
         queued = (QUEUED_BYTES + sim.ball_count * QUEUED_BYTES_PER_BALL) / LEAD_FRAME  # a simulated s
         reach = min(self.hold_reach, HOLD_MEMORY / queued)
         ghosts = sim.timeline.ghosts
         if ghosts is not None:
             reach = min(reach, ghosts.span * sim.timestep)
-        return max(reach, self.lead)
+        return reach
 
     def _ghosts_behind(self) -> bool:
         """The ghosts, stepped in their own process, have not reached the step of the run's next batch."""
