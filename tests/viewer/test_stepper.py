@@ -319,8 +319,7 @@ def test_the_tuning_comes_from_the_environment_only_where_the_viewer_starts_the_
 
 def _held(physics: PhysicsThread) -> bool:
     """The scene waits for X while the thread has stepped a lead of its drop."""
-    sim = physics.sim
-    return sim.held and sim.world.time >= physics.lead - 1e-9 and not physics._commands
+    return _held_to(physics, physics.lead)
 
 
 def test_a_waiting_scene_is_stepped_ahead_but_shown_at_its_first_state_until_x():
@@ -438,16 +437,25 @@ def _held_to(physics: PhysicsThread, seconds: float) -> bool:
     return sim.held and sim.world.time >= seconds - 1e-9 and not physics._commands
 
 
+def _holding(monkeypatch, ghosts: bool = False, **tuning) -> PhysicsThread:
+    """A thread running free beside three balls waiting for X (with the ghosts on), its hold not cut
+    short by HOLD_SECONDS however long a loaded machine takes to step it."""
+    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
+    physics = PhysicsThread(Simulation(line_of_balls(3)), **tuning)
+    if ghosts:
+        physics.submit(lambda s: s.toggle_ghosts())
+    physics.run_free()
+    return physics
+
+
 def test_a_small_scene_is_held_to_its_reach_and_shown_from_x_without_a_step_while_the_queue_lasts(
     monkeypatch,
 ):
     # held 6 s into its drop: after X the first 4.5 s are shown from the queue (it stays a lead of
     # 1.5 s ahead), the thread taking no step, and the HUD counts the steps it shows
-    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)  # however long a loaded machine takes
-    sim = Simulation(line_of_balls(3))
-    physics = PhysicsThread(sim, hold_reach=6.0)
+    physics = _holding(monkeypatch, hold_reach=6.0)
+    sim = physics.sim
     try:
-        physics.run_free()
         assert wait_for(lambda: _held_to(physics, 6.0), timeout=60)
         time.sleep(0.2)
         assert sim.world.time <= 6.0 + stepper.LEAD_FRAME + 1e-9  # no further than its reach
@@ -473,11 +481,9 @@ def test_a_hold_queues_no_more_states_than_its_memory_allows(monkeypatch):
     # the 1.5 s lead (pile10k.toml's snapshots are 5.7 MB each)
     per_second = (stepper.QUEUED_BYTES + 3 * stepper.QUEUED_BYTES_PER_BALL) / stepper.LEAD_FRAME
     monkeypatch.setattr(stepper, "HOLD_MEMORY", 1.0 * per_second)
-    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
-    sim = Simulation(line_of_balls(3))
-    physics = PhysicsThread(sim, hold_reach=10.0)
+    physics = _holding(monkeypatch, hold_reach=10.0)
+    sim = physics.sim
     try:
-        physics.run_free()
         assert wait_for(lambda: _held_to(physics, 1.0))
         time.sleep(0.3)
         held, queued = sim.world.time, len(physics._ahead)
@@ -492,12 +498,9 @@ def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step(monke
     # the run held 10 s ahead of what is shown, the ghosts' process further still: each state queued
     # was captured with the ghosts (and their energies, for the HUD) of its own step, and the frames of
     # the steps shown are still kept when the window comes to them
-    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
-    sim = Simulation(line_of_balls(3))
-    physics = PhysicsThread(sim, ghosts_apart=True, hold_reach=10.0)
+    physics = _holding(monkeypatch, ghosts=True, ghosts_apart=True, hold_reach=10.0)
+    sim = physics.sim
     try:
-        physics.submit(lambda s: s.toggle_ghosts())
-        physics.run_free()
         assert wait_for(lambda: _held_to(physics, physics._reach()), timeout=300)
         with physics._handover_lock:
             queued = [state for _, state in physics._ahead]
@@ -519,13 +522,9 @@ def test_every_state_shown_from_a_long_hold_has_the_ghosts_of_its_own_step(monke
 
 
 def test_a_hold_with_the_ghosts_stepped_on_its_own_thread_reaches_as_far_as_without_them(monkeypatch):
-    monkeypatch.setattr(stepper, "HOLD_SECONDS", math.inf)
-    sim = Simulation(line_of_balls(3))
-    physics = PhysicsThread(sim, ghosts_apart=False, hold_reach=3.0)
+    physics = _holding(monkeypatch, ghosts=True, ghosts_apart=False, hold_reach=3.0)
     try:
-        physics.submit(lambda s: s.toggle_ghosts())
-        physics.run_free()
         assert wait_for(lambda: _held_to(physics, 3.0))
-        assert not sim.timeline.ghosts.remote
+        assert not physics.sim.timeline.ghosts.remote
     finally:
         physics.stop()

@@ -359,6 +359,7 @@ class RemoteGhosts(GhostRun):
 
     @property
     def reached(self) -> int | None:
+        """The latest step of the main run the child has sent the ghosts of (None: none yet)."""
         return self.host.reached
 
     @property

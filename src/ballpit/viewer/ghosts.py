@@ -109,11 +109,6 @@ class GhostRun:
         """Each ghost's total energy at ``step`` of the main run, or None when not known (yet)."""
         raise NotImplementedError
 
-    @property
-    def reached(self) -> int | None:
-        """The latest step of the main run the ghosts are known at (None: none yet)."""
-        raise NotImplementedError
-
     def drifts(self, main: Any, step: int | None) -> list[tuple[str, float, bool]]:
         """(integrator, drift, is the main run) for the main run and each ghost whose energy at ``step``
         is known (the nearest earlier one when not yet)."""
@@ -179,10 +174,6 @@ class Ghosts(GhostRun):
     @property
     def latest(self) -> int:
         return next(iter(self.histories.values())).latest if self.histories else self.origin_step
-
-    @property
-    def reached(self) -> int:
-        return self.current
 
     def stepped(self) -> None:
         """The main run took a live step: each ghost takes one with its own integrator."""

@@ -391,12 +391,12 @@ class PhysicsThread:
     def _leave_the_frame_first(self) -> None:
         """Before each step of a batch taken far ahead: unless the thread is busy, wait (by choice)
         until the window's thread has laid out its frame, GATE_WAIT at most."""
-        if self.busy_fraction <= GATE_BUSY and not self._window_free.is_set():
-            self._idle(self._window_free, GATE_WAIT)
+        if self.busy_fraction <= GATE_BUSY:
+            self._after_the_frame()
 
     def _after_the_frame(self) -> None:
-        """Before each step held past the lead: wait (by choice) until the window's thread has laid out
-        its frame, GATE_WAIT at most."""
+        """Before each step held past the lead (and far ahead, ``_leave_the_frame_first``): wait (by
+        choice) until the window's thread has laid out its frame, GATE_WAIT at most."""
         if not self._window_free.is_set():
             self._idle(self._window_free, GATE_WAIT)
 
@@ -476,7 +476,7 @@ class PhysicsThread:
         else:  # far ahead, with time to spare: the window's frame first
             first = self._leave_the_frame_first if ahead >= self.gate_ahead else None
         waited = self.idle_seconds
-        sim.lead(max(1, round(LEAD_FRAME / sim.timestep)), first)
+        sim.lead(self._batch_steps(), first)
         waited = self.idle_seconds - waited  # for the window's frame, before steps
         state = self._capture(force_hud=False, ahead=True)
         done = time.perf_counter()
@@ -527,12 +527,15 @@ class PhysicsThread:
 
     def _ghosts_behind(self) -> bool:
         """The ghosts, stepped in their own process, have not reached the step of the run's next batch."""
-        sim = self.sim
-        ghosts, history = sim.timeline.ghosts, sim.timeline.history
+        ghosts, history = self.sim.timeline.ghosts, self.sim.timeline.history
         if ghosts is None or not ghosts.remote or history is None:  # stepped here, with the run
             return False
         reached = ghosts.reached
-        return reached is None or reached < history.current + max(1, round(LEAD_FRAME / sim.timestep))
+        return reached is None or reached < history.current + self._batch_steps()
+
+    def _batch_steps(self) -> int:
+        """The steps of one batch taken ahead: LEAD_FRAME of simulated time, one at least."""
+        return max(1, round(LEAD_FRAME / self.sim.timestep))
 
     def _start_hold(self) -> None:
         """Hold the drop: the state shown now is its first (step 0 of the history it starts)."""
